@@ -1,0 +1,35 @@
+//! The ECS layer: heliodon's state as Bevy resources and entities, updated by
+//! systems in named sets. [`HeliodonPlugins`] is everything that simulates;
+//! it runs headless (`MinimalPlugins` + `AssetPlugin`) as well as in the
+//! viewer. Drawing lives in [`crate::render`], windows and input in
+//! [`crate::viewer`].
+
+mod scene_asset;
+mod scene_plugin;
+
+use bevy::app::PluginGroupBuilder;
+use bevy::prelude::*;
+
+pub use scene_asset::{PanelRegistry, SceneAsset, SceneLoader, describe_load_failure, scene_asset_path};
+pub use scene_plugin::{
+    ActiveScene, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, ScenePlugin, SceneRoot, SceneSpawned,
+    SceneSurface, SceneSensor, SceneWindow, Site,
+};
+
+/// The simulation plugins, in dependency order.
+pub struct HeliodonPlugins;
+
+impl PluginGroup for HeliodonPlugins {
+    fn build(self) -> PluginGroupBuilder {
+        PluginGroupBuilder::start::<Self>().add(ScenePlugin)
+    }
+}
+
+/// heliodon's systems, in the order they run each frame in `Update`.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum HeliodonSystems {
+    /// Start loading requested scene files.
+    LoadScene,
+    /// Replace the scene entities once a load has finished.
+    SpawnScene,
+}

@@ -1,0 +1,202 @@
+//! [`ScenePlugin`]: opens scene files ([`OpenScene`]), and once loaded
+//! replaces the scene's entities: one per material, surface, window and
+//! sensor, under one [`SceneRoot`], and the [`Site`] resource.
+
+use std::ops::{Deref, Range};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use bevy::asset::AssetLoadFailedEvent;
+use bevy::prelude::*;
+
+use super::scene_asset::{SceneAsset, SceneLoader, describe_load_failure, scene_asset_path};
+use super::{HeliodonSystems, PanelRegistry};
+use crate::scene::{self, Scene};
+
+pub struct ScenePlugin;
+
+impl Plugin for ScenePlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<PanelRegistry>()
+            .init_asset::<SceneAsset>()
+            .init_asset_loader::<SceneLoader>()
+            .init_resource::<ActiveScene>()
+            .add_message::<OpenScene>()
+            .add_message::<SceneSpawned>()
+            .add_message::<SceneLoadFailed>()
+            .configure_sets(Update, (HeliodonSystems::LoadScene, HeliodonSystems::SpawnScene).chain())
+            .add_systems(Update, request_scene.in_set(HeliodonSystems::LoadScene))
+            .add_systems(Update, (spawn_loaded_scene, report_failed_load).in_set(HeliodonSystems::SpawnScene));
+    }
+}
+
+/// Ask for a scene file to be opened (replacing the current scene).
+#[derive(Message, Debug, Clone)]
+pub struct OpenScene(pub PathBuf);
+
+/// The scene's entities were (re)spawned.
+#[derive(Message, Debug, Clone)]
+pub struct SceneSpawned {
+    pub root: Entity,
+}
+
+/// A requested scene could not be loaded; `message` is one line.
+#[derive(Message, Debug, Clone)]
+pub struct SceneLoadFailed {
+    pub path: PathBuf,
+    pub message: String,
+}
+
+/// The scene being shown, and the one being loaded.
+#[derive(Resource, Default)]
+pub struct ActiveScene {
+    /// The loaded scene, once there is one.
+    pub scene: Option<Arc<Scene>>,
+    pub root: Option<Entity>,
+    pending: Option<(PathBuf, Handle<SceneAsset>)>,
+}
+
+impl ActiveScene {
+    pub fn is_loading(&self) -> bool {
+        self.pending.is_some()
+    }
+}
+
+/// The site of the active scene.
+#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+pub struct Site(pub crate::site::Site);
+
+impl Deref for Site {
+    type Target = crate::site::Site;
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
+
+/// The entity all of a scene's entities hang under; despawning it removes the scene.
+#[derive(Component, Debug)]
+pub struct SceneRoot;
+
+#[derive(Component, Debug, Clone)]
+pub struct SceneMaterial {
+    /// Index into [`Scene::materials`].
+    pub index: u32,
+    pub material: scene::Material,
+}
+
+/// A surface and the lighting patches it is cut into.
+#[derive(Component, Debug, Clone)]
+pub struct SceneSurface {
+    /// Index into [`Scene::surfaces`].
+    pub index: u32,
+    pub patches: Range<u32>,
+    pub area: f32,
+    pub normal: Vec3,
+}
+
+/// The material entity of a surface or window.
+#[derive(Component, Debug, Clone, Copy)]
+pub struct MaterialOf(pub Entity);
+
+/// An aperture (glass or panel).
+#[derive(Component, Debug, Clone)]
+pub struct SceneWindow {
+    /// Index into [`Scene::windows`].
+    pub index: u32,
+    pub window: scene::Window,
+}
+
+#[derive(Component, Debug, Clone)]
+pub struct SceneSensor(pub scene::Sensor);
+
+fn request_scene(
+    mut requests: MessageReader<OpenScene>,
+    asset_server: Res<AssetServer>,
+    mut active: ResMut<ActiveScene>,
+) {
+    if let Some(OpenScene(path)) = requests.read().last() {
+        let handle = asset_server.load(scene_asset_path(path));
+        active.pending = Some((path.clone(), handle));
+    }
+}
+
+fn spawn_loaded_scene(
+    mut commands: Commands,
+    mut active: ResMut<ActiveScene>,
+    assets: Res<Assets<SceneAsset>>,
+    asset_server: Res<AssetServer>,
+    mut spawned: MessageWriter<SceneSpawned>,
+) {
+    let Some((_, handle)) = &active.pending else { return };
+    if !asset_server.is_loaded_with_dependencies(handle.id()) {
+        return;
+    }
+    let Some(asset) = assets.get(handle) else { return };
+    let scene = asset.scene.clone();
+    if let Some(old) = active.root.take() {
+        commands.entity(old).despawn();
+    }
+    let root = spawn_scene(&mut commands, &scene);
+    commands.insert_resource(Site(scene.site));
+    active.scene = Some(scene);
+    active.root = Some(root);
+    active.pending = None;
+    spawned.write(SceneSpawned { root });
+}
+
+fn report_failed_load(
+    mut failures: MessageReader<AssetLoadFailedEvent<SceneAsset>>,
+    mut active: ResMut<ActiveScene>,
+    mut failed: MessageWriter<SceneLoadFailed>,
+) {
+    for failure in failures.read() {
+        let Some((path, handle)) = &active.pending else { continue };
+        if handle.id() != failure.id {
+            continue;
+        }
+        let message = describe_load_failure(&failure.error);
+        failed.write(SceneLoadFailed { path: path.clone(), message });
+        active.pending = None;
+    }
+}
+
+fn spawn_scene(commands: &mut Commands, scene: &Scene) -> Entity {
+    let root = commands.spawn((SceneRoot, Name::new(scene.name.clone()), Transform::default(), Visibility::default())).id();
+    let materials: Vec<Entity> = scene
+        .materials
+        .iter()
+        .enumerate()
+        .map(|(index, material)| {
+            commands
+                .spawn((
+                    SceneMaterial { index: index as u32, material: material.clone() },
+                    Name::new(material.name.clone()),
+                    ChildOf(root),
+                ))
+                .id()
+        })
+        .collect();
+    for (index, surface) in scene.surfaces.iter().enumerate() {
+        commands.spawn((
+            SceneSurface {
+                index: index as u32,
+                patches: surface.patches.clone(),
+                area: surface.area,
+                normal: surface.normal,
+            },
+            MaterialOf(materials[surface.material as usize]),
+            ChildOf(root),
+        ));
+    }
+    for (index, window) in scene.windows.iter().enumerate() {
+        commands.spawn((
+            SceneWindow { index: index as u32, window: window.clone() },
+            MaterialOf(materials[window.material as usize]),
+            ChildOf(root),
+        ));
+    }
+    for sensor in &scene.sensors {
+        commands.spawn((SceneSensor(sensor.clone()), Name::new(sensor.name.clone()), ChildOf(root)));
+    }
+    root
+}

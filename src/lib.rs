@@ -1,0 +1,47 @@
+//! heliodon: a digital heliodon for daylighting design.
+//!
+//! Layers, from the bottom (see ARCHITECTURE.md):
+//! - science, plain Rust without Bevy types: [`site`], [`scene`];
+//! - the ECS layer: [`ecs`] ([`HeliodonPlugins`], runs headless);
+//! - drawing: [`render`]; the window and its input: [`viewer`];
+//! - the command line: [`cli`].
+
+pub mod cli;
+pub mod ecs;
+pub mod render;
+pub mod scene;
+pub mod site;
+pub mod viewer;
+
+use std::path::{Path, PathBuf};
+
+use bevy::asset::{AssetMetaCheck, AssetPlugin, UnapprovedPathMode};
+
+pub use ecs::HeliodonPlugins;
+
+/// The `AssetPlugin` heliodon apps need: scene files are opened by absolute
+/// path wherever they are, and carry no `.meta` files.
+pub fn asset_plugin() -> AssetPlugin {
+    AssetPlugin {
+        unapproved_path_mode: UnapprovedPathMode::Allow,
+        meta_check: AssetMetaCheck::Never,
+        ..Default::default()
+    }
+}
+
+/// The bundled scenes, by folder name under `assets/scenes/`.
+pub const BUNDLED_SCENES: [&str; 3] = ["test_room", "office", "living_room"];
+
+/// The scene the viewer opens when given none.
+pub const DEFAULT_SCENE: &str = "office";
+
+/// Path of a bundled scene: under `./assets` when run from a checkout's root,
+/// else under the crate's own folder.
+pub fn bundled_scene(name: &str) -> PathBuf {
+    let relative = Path::new("assets/scenes").join(name).join("scene.toml");
+    if relative.exists() {
+        relative
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
+    }
+}

@@ -1,0 +1,260 @@
+//! Scene loading: a scene file (TOML) with its OBJ and MTL turned into the
+//! geometry, materials, windows, patches and sensors every other part of
+//! heliodon works on. Plain Rust, no Bevy types: the Bevy asset loader, the
+//! CLI and the tests all go through [`load_scene_with`].
+//!
+//! Everything is in one canonical frame: metres, x east, y north, z up (as in
+//! Radiance). [`ModelFrame`] maps the model's own axes, north and units into it.
+
+mod error;
+mod file;
+mod frame;
+mod material;
+mod obj;
+mod patches;
+mod sensors;
+mod surfaces;
+
+use std::collections::BTreeSet;
+use std::future::Future;
+use std::io;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+pub use error::{Location, SceneError, SceneWarning, line_of};
+pub use frame::{ModelFrame, UpAxis};
+pub use material::{Material, MaterialKind, MaterialOrigin, Rgb};
+pub use patches::{Patch, PatchMesh};
+pub use sensors::{DEFAULT_FOV, Sensor, Viewpoint};
+
+use crate::site::Site;
+
+/// Default side of the largest lighting patch, in metres.
+pub const DEFAULT_PATCH_SIZE: f32 = 0.5;
+
+/// A loaded scene in the canonical frame (metres, x east, y north, z up).
+#[derive(Debug, Clone)]
+pub struct Scene {
+    pub name: String,
+    pub files: SceneFiles,
+    pub site: Site,
+    pub frame: ModelFrame,
+    pub lighting: LightingSettings,
+    pub materials: Vec<Material>,
+    /// The model's triangles after the frame mapping, degenerate ones dropped,
+    /// ordered by surface.
+    pub triangles: Vec<Triangle>,
+    pub surfaces: Vec<Surface>,
+    pub windows: Vec<Window>,
+    pub patches: PatchMesh,
+    pub sensors: Vec<Sensor>,
+    pub viewpoints: Vec<Viewpoint>,
+    /// Axis-aligned bounds of all triangles: (min, max).
+    pub bounds: (Vec3, Vec3),
+}
+
+/// The files a scene was read from, as the user would name them.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct SceneFiles {
+    pub scene: PathBuf,
+    pub obj: PathBuf,
+    pub mtls: Vec<PathBuf>,
+}
+
+/// Settings of the lighting simulation that shape the geometry it works on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightingSettings {
+    /// Patches fit in a square of this side (metres).
+    pub patch_size: f32,
+}
+
+impl Default for LightingSettings {
+    fn default() -> Self {
+        Self { patch_size: DEFAULT_PATCH_SIZE }
+    }
+}
+
+/// One triangle of the model, single-sided as in Radiance (both sides reflect).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Triangle {
+    pub vertices: [Vec3; 3],
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+}
+
+impl Triangle {
+    /// Twice the area times the unit normal (counter-clockwise winding).
+    pub fn cross(&self) -> Vec3 {
+        let [a, b, c] = self.vertices;
+        (b - a).cross(c - a)
+    }
+
+    pub fn area(&self) -> f32 {
+        0.5 * self.cross().length()
+    }
+
+    pub fn normal(&self) -> Vec3 {
+        self.cross().normalize_or_zero()
+    }
+
+    pub fn centroid(&self) -> Vec3 {
+        let [a, b, c] = self.vertices;
+        (a + b + c) / 3.0
+    }
+}
+
+/// A connected, planar group of triangles of one material: a wall, a desk top,
+/// a window pane. Patches subdivide surfaces.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Surface {
+    pub material: u32,
+    /// Range into [`Scene::triangles`].
+    pub triangles: Range<u32>,
+    /// Range into [`PatchMesh::patches`].
+    pub patches: Range<u32>,
+    /// Area-weighted unit normal.
+    pub normal: Vec3,
+    pub area: f32,
+}
+
+/// An aperture: a surface of a transmitting material (glass or panel).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Window {
+    /// Index into [`Scene::surfaces`].
+    pub surface: u32,
+    pub material: u32,
+    pub area: f32,
+    pub normal: Vec3,
+    pub centroid: Vec3,
+}
+
+/// A scene and what the user should hear about it.
+#[derive(Debug, Clone)]
+pub struct LoadedScene {
+    pub scene: Scene,
+    pub warnings: Vec<SceneWarning>,
+}
+
+/// Reads the files a scene refers to. The loader stays independent of where
+/// bytes come from: the file system for the CLI, Bevy's asset readers in apps.
+pub trait SceneReader {
+    fn read(&mut self, path: &Path) -> impl Future<Output = io::Result<Vec<u8>>>;
+}
+
+/// Reads straight from the file system.
+pub struct FsReader;
+
+impl SceneReader for FsReader {
+    async fn read(&mut self, path: &Path) -> io::Result<Vec<u8>> {
+        std::fs::read(path)
+    }
+}
+
+/// What the loader knows about panels: the names registered by panel plugins.
+pub type PanelNames = BTreeSet<String>;
+
+/// Loads a scene file from disk.
+pub fn load_scene(path: &Path, panels: &PanelNames) -> Result<LoadedScene, SceneError> {
+    futures_lite::future::block_on(load_scene_with(path, panels, &mut FsReader))
+}
+
+/// Loads a scene file and everything it refers to through `reader`.
+pub async fn load_scene_with(
+    scene_path: &Path,
+    panels: &PanelNames,
+    reader: &mut impl SceneReader,
+) -> Result<LoadedScene, SceneError> {
+    let scene_text = read_text(reader, scene_path, None).await?;
+    let parsed = file::parse(scene_path, &scene_text)?;
+    let obj_path = parsed.obj_path();
+    let obj_text = read_text(reader, &obj_path, Some(parsed.obj_location())).await?;
+    let obj_scan = obj::scan(&obj_path, &obj_text)?;
+    let mut mtls = Vec::new();
+    for library in &obj_scan.material_libraries {
+        let path = obj_path.parent().unwrap_or(Path::new("")).join(&library.name);
+        let location = Location::line(&obj_path, library.line);
+        let text = read_text(reader, &path, Some(location)).await?;
+        mtls.push((path, text));
+    }
+    build(parsed, obj_path, &obj_text, obj_scan, mtls, panels)
+}
+
+async fn read_text(
+    reader: &mut impl SceneReader,
+    path: &Path,
+    referenced_at: Option<Location>,
+) -> Result<String, SceneError> {
+    let bytes = reader.read(path).await.map_err(|error| {
+        let what = match error.kind() {
+            io::ErrorKind::NotFound => "not found".to_string(),
+            _ => error.to_string(),
+        };
+        match referenced_at {
+            Some(location) => SceneError::new(location, format!("cannot read '{}': {what}", path.display())),
+            None => SceneError::new(Location::file(path), format!("cannot read scene file: {what}")),
+        }
+    })?;
+    String::from_utf8(bytes).map_err(|_| SceneError::new(Location::file(path), "not UTF-8 text"))
+}
+
+fn build(
+    parsed: file::ParsedScene,
+    obj_path: PathBuf,
+    obj_text: &str,
+    obj_scan: obj::ObjScan,
+    mtls: Vec<(PathBuf, String)>,
+    panels: &PanelNames,
+) -> Result<LoadedScene, SceneError> {
+    let mut warnings = Vec::new();
+    let model = obj::import(&obj_path, obj_text, &obj_scan, &mtls)?;
+    let (materials, material_of) = material::resolve(&parsed, &model, panels, &obj_path, &mut warnings)?;
+    let raw_triangles = obj::triangles(&model, &parsed.frame, &material_of, &obj_path, &mut warnings)?;
+    let (triangles, mut surfaces) = surfaces::group(raw_triangles);
+    let patches = patches::subdivide(&triangles, &mut surfaces, parsed.lighting.patch_size);
+    let windows = surfaces::windows(&triangles, &surfaces, &materials);
+    let sensors = sensors::sensors(&parsed)?;
+    let viewpoints = sensors::viewpoints(&parsed)?;
+    let bounds = bounds(&triangles);
+    Ok(LoadedScene {
+        scene: Scene {
+            name: parsed.name.clone(),
+            files: SceneFiles {
+                scene: parsed.path.clone(),
+                obj: obj_path,
+                mtls: mtls.into_iter().map(|(path, _)| path).collect(),
+            },
+            site: parsed.site,
+            frame: parsed.frame,
+            lighting: parsed.lighting,
+            materials,
+            triangles,
+            surfaces,
+            windows,
+            patches,
+            sensors,
+            viewpoints,
+            bounds,
+        },
+        warnings,
+    })
+}
+
+fn bounds(triangles: &[Triangle]) -> (Vec3, Vec3) {
+    triangles.iter().flat_map(|t| t.vertices).fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), v| (lo.min(v), hi.max(v)),
+    )
+}
+
+impl Scene {
+    pub fn material(&self, id: u32) -> &Material {
+        &self.materials[id as usize]
+    }
+
+    /// Total glazed area per material, for summaries.
+    pub fn window_area(&self) -> f32 {
+        self.windows.iter().map(|w| w.area).sum()
+    }
+}

@@ -1,0 +1,127 @@
+//! A CAD-like camera: left-drag orbits about the focus, right- or middle-drag
+//! pans, the wheel zooms toward the point under the cursor, `F` frames the
+//! whole model. z is up.
+
+use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll, MouseScrollUnit};
+use bevy::prelude::*;
+use bevy::window::PrimaryWindow;
+
+use crate::ecs::ActiveScene;
+use crate::render::framing;
+use crate::scene::Viewpoint;
+
+/// Orbit state; the transform is derived from it every frame.
+#[derive(Component, Debug, Clone, Copy)]
+pub struct CadCamera {
+    pub focus: Vec3,
+    /// Distance from the eye to the focus.
+    pub distance: f32,
+    /// Azimuth of the eye around the focus, radians counter-clockwise from +x.
+    pub yaw: f32,
+    /// Elevation of the eye above the focus, radians.
+    pub pitch: f32,
+}
+
+/// Radians of orbit per pixel of drag.
+const ORBIT_SPEED: f32 = 0.006;
+/// Zoom factor per wheel line.
+const ZOOM_STEP: f32 = 0.85;
+const PIXELS_PER_LINE: f32 = 40.0;
+const MAX_PITCH: f32 = 1.55;
+
+impl CadCamera {
+    pub fn looking(eye: Vec3, target: Vec3) -> Self {
+        let offset = eye - target;
+        let distance = offset.length().max(1e-3);
+        Self {
+            focus: target,
+            distance,
+            yaw: offset.y.atan2(offset.x),
+            pitch: (offset.z / distance).clamp(-1.0, 1.0).asin(),
+        }
+    }
+
+    pub fn from_viewpoint(view: &Viewpoint) -> Self {
+        Self::looking(view.eye, view.target)
+    }
+
+    pub fn eye(&self) -> Vec3 {
+        let (sy, cy) = self.yaw.sin_cos();
+        let (sp, cp) = self.pitch.sin_cos();
+        self.focus + self.distance * Vec3::new(cp * cy, cp * sy, sp)
+    }
+
+    pub fn transform(&self) -> Transform {
+        Transform::from_translation(self.eye()).looking_at(self.focus, Vec3::Z)
+    }
+}
+
+pub fn navigate(
+    mouse: Res<ButtonInput<MouseButton>>,
+    keys: Res<ButtonInput<KeyCode>>,
+    motion: Res<AccumulatedMouseMotion>,
+    scroll: Res<AccumulatedMouseScroll>,
+    window: Single<&Window, With<PrimaryWindow>>,
+    active: Res<ActiveScene>,
+    mut cameras: Query<(&mut CadCamera, &mut Transform, &Camera, &GlobalTransform, &Projection)>,
+) {
+    for (mut cad, mut transform, camera, global, projection) in &mut cameras {
+        let fov = match projection {
+            Projection::Perspective(p) => p.fov,
+            _ => std::f32::consts::FRAC_PI_3,
+        };
+        let delta = motion.delta;
+        if mouse.pressed(MouseButton::Left) && delta != Vec2::ZERO {
+            cad.yaw -= delta.x * ORBIT_SPEED;
+            cad.pitch = (cad.pitch + delta.y * ORBIT_SPEED).clamp(-MAX_PITCH, MAX_PITCH);
+        }
+        if (mouse.pressed(MouseButton::Right) || mouse.pressed(MouseButton::Middle)) && delta != Vec2::ZERO {
+            // One pixel moves the focus by what a pixel spans at the focus distance.
+            let per_pixel = 2.0 * cad.distance * (fov / 2.0).tan() / window.height().max(1.0);
+            let right = transform.right().as_vec3();
+            let up = transform.up().as_vec3();
+            cad.focus += (-delta.x * right + delta.y * up) * per_pixel;
+        }
+        let lines = match scroll.unit {
+            MouseScrollUnit::Line => scroll.delta.y,
+            MouseScrollUnit::Pixel => scroll.delta.y / PIXELS_PER_LINE,
+        };
+        if lines != 0.0 {
+            let factor = ZOOM_STEP.powf(lines);
+            // Scale the eye and the focus about the point under the cursor on
+            // the plane through the focus facing the camera.
+            let anchor = window
+                .cursor_position()
+                .and_then(|cursor| camera.viewport_to_world(global, cursor).ok())
+                .and_then(|ray| {
+                    let normal = global.forward().as_vec3();
+                    let t = ray.intersect_plane(cad.focus, InfinitePlane3d::new(normal))?;
+                    Some(ray.get_point(t))
+                })
+                .unwrap_or(cad.focus);
+            cad.focus = anchor + (cad.focus - anchor) * factor;
+            cad.distance *= factor;
+        }
+        if keys.just_pressed(KeyCode::KeyF)
+            && let Some(scene) = &active.scene
+        {
+            let (centre, distance) = framing(scene.bounds, fov.to_degrees());
+            cad.focus = centre;
+            cad.distance = distance;
+        }
+        *transform = cad.transform();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn looking_round_trips_the_eye() {
+        let eye = Vec3::new(-3.0, -4.0, 2.5);
+        let target = Vec3::new(1.0, 2.0, 0.5);
+        let cad = CadCamera::looking(eye, target);
+        assert!((cad.eye() - eye).length() < 1e-4);
+    }
+}

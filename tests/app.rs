@@ -1,0 +1,137 @@
+//! Bevy apps: the simulation plugins headless (no window, no GPU), and a
+//! render smoke test on whatever Vulkan device there is (Mesa's lavapipe in CI).
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use bevy::prelude::*;
+use heliodon::ecs::{
+    ActiveScene, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, SceneSensor, SceneSpawned, SceneSurface,
+    SceneWindow, Site,
+};
+use heliodon::render::offscreen::{self, OffscreenRequest};
+
+fn headless_app() -> App {
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, heliodon::asset_plugin(), heliodon::HeliodonPlugins));
+    app
+}
+
+/// Runs the app until a scene is spawned or fails; returns the failure message.
+fn open(app: &mut App, path: PathBuf) -> Result<(), String> {
+    app.world_mut().write_message(OpenScene(path));
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        app.update();
+        let world = app.world_mut();
+        if let Some(failed) = world.resource_mut::<Messages<SceneLoadFailed>>().drain().last() {
+            return Err(failed.message);
+        }
+        if world.resource_mut::<Messages<SceneSpawned>>().drain().last().is_some() {
+            app.update(); // apply the spawn commands
+            return Ok(());
+        }
+        assert!(Instant::now() < deadline, "scene did not load in time");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
+struct Expected {
+    name: &'static str,
+    diffuse: usize,
+    glass: usize,
+    windows: usize,
+    window_area: f32,
+    sensors: usize,
+    latitude: f64,
+}
+
+#[test]
+fn every_bundled_scene_spawns_its_entities() {
+    let expected = [
+        Expected { name: "test_room", diffuse: 3, glass: 1, windows: 6, window_area: 4.59, sensors: 65, latitude: 42.36 },
+        Expected { name: "office", diffuse: 7, glass: 3, windows: 12, window_area: 24.88, sensors: 150, latitude: 42.36 },
+        Expected {
+            name: "living_room",
+            diffuse: 5,
+            glass: 2,
+            windows: 16,
+            window_area: 15.300,
+            sensors: 28,
+            latitude: 37.77,
+        },
+    ];
+    // One app opens the scenes in turn: each replaces the previous one.
+    let mut app = headless_app();
+    for e in expected {
+        open(&mut app, heliodon::bundled_scene(e.name)).unwrap();
+        let world = app.world_mut();
+        let scene = world.resource::<ActiveScene>().scene.clone().expect("active scene");
+        assert_eq!(world.resource::<Site>().latitude, e.latitude, "{}", e.name);
+
+        let mut materials = world.query::<&SceneMaterial>();
+        let kinds: Vec<&str> = materials.iter(world).map(|m| m.material.kind.label()).collect();
+        assert_eq!(kinds.iter().filter(|k| **k == "diffuse").count(), e.diffuse, "{}", e.name);
+        assert_eq!(kinds.iter().filter(|k| **k == "glass").count(), e.glass, "{}", e.name);
+
+        let mut windows = world.query::<(&SceneWindow, &MaterialOf)>();
+        let mut area = 0.0;
+        let mut count = 0;
+        for (window, material) in windows.iter(world) {
+            area += window.window.area;
+            count += 1;
+            let kind = &world.get::<SceneMaterial>(material.0).expect("window material entity").material.kind;
+            assert!(kind.transmits(), "{}: window of {kind:?}", e.name);
+        }
+        assert_eq!(count, e.windows, "{}", e.name);
+        assert!((area - e.window_area).abs() < 2e-3, "{}: {area}", e.name);
+
+        let mut surfaces = world.query::<&SceneSurface>();
+        let patches: u32 = surfaces.iter(world).map(|s| s.patches.end - s.patches.start).sum();
+        assert_eq!(surfaces.iter(world).count(), scene.surfaces.len(), "{}", e.name);
+        assert_eq!(patches as usize, scene.patches.patches.len(), "{}", e.name);
+
+        let mut sensors = world.query::<&SceneSensor>();
+        assert_eq!(sensors.iter(world).count(), e.sensors, "{}", e.name);
+    }
+}
+
+#[test]
+fn a_failed_load_reports_one_line_and_keeps_the_previous_scene() {
+    let mut app = headless_app();
+    open(&mut app, heliodon::bundled_scene("test_room")).unwrap();
+    let missing = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("missing/scene.toml");
+    let message = open(&mut app, missing.clone()).unwrap_err();
+    assert!(message.contains("missing/scene.toml") && message.contains("not found"), "{message}");
+    assert!(!message.contains('\n'));
+    let world = app.world_mut();
+    assert_eq!(world.resource::<ActiveScene>().scene.as_ref().unwrap().name, "Small test room");
+    assert_eq!(world.query::<&SceneWindow>().iter(world).count(), 6);
+}
+
+#[test]
+fn render_smoke_test_draws_the_model() {
+    let request = OffscreenRequest { scene: heliodon::bundled_scene("test_room"), view: None, width: 320, height: 240 };
+    let image = offscreen::render(request).expect("render");
+    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render_smoke_test_room.png");
+    image.save_png(&out).unwrap();
+    println!("wrote {}", out.display());
+    assert_eq!((image.width, image.height), (320, 240));
+    let pixels: Vec<[u8; 4]> = image.rgba.chunks_exact(4).map(|p| [p[0], p[1], p[2], p[3]]).collect();
+    // From inside the closed room (the scene's first camera) nearly every
+    // pixel is a surface: the clear colour shows only through the glass.
+    let clear = [209u8, 219, 230];
+    let background = pixels.iter().filter(|p| p[..3].iter().zip(clear).all(|(a, b)| a.abs_diff(b) <= 2)).count();
+    assert!(background < pixels.len() / 10, "{background} background pixels of {}", pixels.len());
+    // Walls, floor and ceiling face different ways and have different
+    // reflectances: the image has distinct shades, neither black nor flat.
+    let luminance: Vec<f32> = pixels.iter().map(|p| 0.2126 * p[0] as f32 + 0.7152 * p[1] as f32 + 0.0722 * p[2] as f32).collect();
+    let mean = luminance.iter().sum::<f32>() / luminance.len() as f32;
+    let spread = (luminance.iter().map(|l| (l - mean).powi(2)).sum::<f32>() / luminance.len() as f32).sqrt();
+    assert!(mean > 30.0 && mean < 240.0, "mean luminance {mean}");
+    assert!(spread > 10.0, "luminance spread {spread}");
+    let mut levels: Vec<u8> = luminance.iter().map(|l| (*l / 16.0) as u8).collect();
+    levels.sort_unstable();
+    levels.dedup();
+    assert!(levels.len() >= 4, "shades {levels:?}");
+}

@@ -1,0 +1,420 @@
+//! Scene loading without Bevy: the bundled scenes against values known from
+//! their generator, every kind of bad input, and the `info` command line.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use heliodon::scene::{LoadedScene, MaterialKind, PanelNames, SceneError, load_scene};
+
+fn no_panels() -> PanelNames {
+    PanelNames::new()
+}
+
+fn bundled(name: &str) -> LoadedScene {
+    load_scene(&heliodon::bundled_scene(name), &no_panels()).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+fn kinds(loaded: &LoadedScene) -> (usize, usize, usize) {
+    let count = |label| loaded.scene.materials.iter().filter(|m| m.kind.label() == label).count();
+    (count("diffuse"), count("glass"), count("panel"))
+}
+
+/// Curved glass of the living room: 14 planar segments of the arc through
+/// (0, 5), (3.5, 6.5), (7, 5) m, glazed from 0.6 to 2.3 m.
+fn living_room_curved_glass() -> f32 {
+    let (half, bulge) = (3.5f32, 1.5f32);
+    let radius = (half * half + bulge * bulge) / (2.0 * bulge);
+    let span = (half / radius).asin();
+    let chord = 2.0 * radius * (span / 14.0).sin();
+    14.0 * chord * 1.7
+}
+
+#[test]
+fn test_room_loads_with_its_six_windows() {
+    let loaded = bundled("test_room");
+    let scene = &loaded.scene;
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    assert_eq!(kinds(&loaded), (3, 1, 0));
+    assert_eq!(scene.windows.len(), 6);
+    let areas: Vec<f32> = scene.windows.iter().map(|w| w.area).collect();
+    assert_eq!(areas.iter().filter(|a| (**a - 0.9).abs() < 1e-4).count(), 3, "{areas:?}");
+    assert_eq!(areas.iter().filter(|a| (**a - 0.63).abs() < 1e-4).count(), 3, "{areas:?}");
+    for window in &scene.windows {
+        // Glazing faces out: south.
+        assert!((window.normal - glam::Vec3::NEG_Y).length() < 1e-5);
+    }
+    assert_eq!(scene.sensors.len(), 5 + 6 * 10);
+    let (lo, hi) = scene.bounds;
+    assert!((lo - glam::Vec3::ZERO).length() < 1e-5 && (hi - glam::Vec3::new(4.0, 6.0, 3.0)).length() < 1e-5);
+    // Walls, floor and ceiling: 4·3·2 + 2·6·3 + 2·4·6 = 108 m² of surface, less 4.59 of glass.
+    let opaque: f32 = scene.surfaces.iter().filter(|s| !scene.material(s.material).kind.transmits()).map(|s| s.area).sum();
+    assert!((opaque - (108.0 - 4.59)).abs() < 1e-3, "{opaque}");
+    // Patches cover every surface exactly and are no larger than the grid cell.
+    let patch_area: f32 = scene.patches.patches.iter().map(|p| p.area).sum();
+    let surface_area: f32 = scene.surfaces.iter().map(|s| s.area).sum();
+    assert!((patch_area - surface_area).abs() < 1e-3);
+    assert!(scene.patches.patches.iter().all(|p| p.area <= 0.25 + 1e-5));
+    // The floor (4 × 6 m) alone is 96 patches of 0.5 m.
+    let floor = scene.materials.iter().position(|m| m.name == "floor").unwrap() as u32;
+    assert_eq!(scene.patches.patches.iter().filter(|p| p.material == floor).count(), 96);
+}
+
+#[test]
+fn grid_sensors_are_named_and_placed_per_the_contract() {
+    let scene = bundled("test_room").scene;
+    let grid: Vec<_> = scene.sensors.iter().filter(|s| s.grid.as_deref() == Some("workplane")).collect();
+    assert_eq!(grid.len(), 60);
+    // Cell centres, x fastest: k = 0 at (0.75, 0.75), k = 1 at (1.25, 0.75), k = 6 at (0.75, 1.25).
+    assert_eq!(grid[0].name, "workplane/0");
+    assert!((grid[0].position - glam::Vec3::new(0.75, 0.75, 0.8)).length() < 1e-5);
+    assert!((grid[1].position - glam::Vec3::new(1.25, 0.75, 0.8)).length() < 1e-5);
+    assert_eq!(grid[6].name, "workplane/6");
+    assert!((grid[6].position - glam::Vec3::new(0.75, 1.25, 0.8)).length() < 1e-5);
+    let back = scene.sensors.iter().find(|s| s.name == "back-wall").unwrap();
+    assert_eq!(back.size, Some(0.5));
+    // A vertical sensor's square has a horizontal edge.
+    assert!(back.axes[0].z.abs() < 1e-6 && back.axes[1].z.abs() > 0.999);
+}
+
+#[test]
+fn office_has_west_windows_and_two_skylights() {
+    let loaded = bundled("office");
+    let scene = &loaded.scene;
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    assert_eq!(kinds(&loaded), (7, 3, 0));
+    assert_eq!(scene.windows.len(), 12);
+    assert!((scene.window_area() - 24.88).abs() < 1e-3, "{}", scene.window_area());
+    let west = scene.windows.iter().filter(|w| (w.normal - glam::Vec3::NEG_X).length() < 1e-5).count();
+    let up = scene.windows.iter().filter(|w| (w.normal - glam::Vec3::Z).length() < 1e-5).count();
+    assert_eq!((west, up), (10, 2));
+    assert_eq!(scene.sensors.len(), 8 + 2 + 10 * 14);
+    // The scene table overrides the MTL: carpet is coloured, view glass 0.7.
+    let carpet = scene.materials.iter().find(|m| m.name == "carpet").unwrap();
+    assert!(matches!(carpet.kind, MaterialKind::Diffuse { reflectance } if reflectance.0 == [0.18, 0.17, 0.15]));
+    let view = scene.materials.iter().find(|m| m.name == "view_glass").unwrap();
+    assert_eq!(view.kind, MaterialKind::Glass { transmittance: 0.7 });
+    // Walls from the MTL alone.
+    let wall = scene.materials.iter().find(|m| m.name == "wall").unwrap();
+    assert!(matches!(wall.kind, MaterialKind::Diffuse { reflectance } if reflectance.0 == [0.6; 3]));
+    assert!(scene.triangles.len() < 5000);
+}
+
+#[test]
+fn living_room_maps_centimetres_y_up_and_turned_north() {
+    let loaded = bundled("living_room");
+    let scene = &loaded.scene;
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    assert_eq!(kinds(&loaded), (5, 2, 0));
+    assert_eq!(scene.windows.len(), 14 + 2);
+    let expected = living_room_curved_glass() + 2.0;
+    assert!((scene.window_area() - expected).abs() < 1e-3, "{} vs {expected}", scene.window_area());
+    // Model height 350 cm (skylight tops) becomes 3.5 m of z.
+    let (lo, hi) = scene.bounds;
+    assert!((hi.z - lo.z - 3.5).abs() < 1e-4, "{lo} {hi}");
+    // The table sensor is 40 cm up and faces up.
+    let table = scene.sensors.iter().find(|s| s.name == "table").unwrap();
+    assert!((table.position.z - 0.4).abs() < 1e-5);
+    assert!((table.normal - glam::Vec3::Z).length() < 1e-5);
+    assert!((table.size.unwrap() - 0.4).abs() < 1e-6);
+    // North (0.5, 0, -0.866) in the model is +y: the back wall's sensor, facing
+    // model +z (30° from south towards east, turned), faces azimuth 150°.
+    let back = scene.sensors.iter().find(|s| s.name == "back-wall").unwrap();
+    let azimuth = back.normal.x.atan2(back.normal.y).to_degrees().rem_euclid(360.0);
+    assert!((azimuth - 150.0).abs() < 0.01, "{azimuth}");
+    assert_eq!(scene.sensors.len(), 4 + 24);
+    // Skylights face up whatever the model's axes.
+    assert_eq!(scene.windows.iter().filter(|w| w.normal.z > 0.9999).count(), 2);
+}
+
+// ---- bad input -------------------------------------------------------------
+
+/// A throwaway scene folder with the given files.
+struct Fixture {
+    dir: PathBuf,
+}
+
+impl Fixture {
+    fn new(name: &str, files: &[(&str, &str)]) -> Self {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("bad_input").join(name);
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        for (file, text) in files {
+            std::fs::write(dir.join(file), text).unwrap();
+        }
+        Self { dir }
+    }
+
+    fn scene(&self) -> PathBuf {
+        self.dir.join("scene.toml")
+    }
+
+    fn load(&self) -> Result<LoadedScene, SceneError> {
+        load_scene(&self.scene(), &no_panels())
+    }
+
+    fn error(&self) -> SceneError {
+        match self.load() {
+            Ok(_) => panic!("{} loaded", self.dir.display()),
+            Err(e) => e,
+        }
+    }
+}
+
+const SITE: &str = "[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n";
+const MTL: &str = "newmtl wall\nKd 0.5 0.5 0.5\n\nnewmtl glass\nd 0.12\n";
+const OBJ: &str = "mtllib room.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl wall\nf 1 2 3\nusemtl glass\nf 1 3 4\n";
+
+fn scene_toml(extra: &str) -> String {
+    format!("name = \"bad\"\n{SITE}\n[model]\nobj = \"room.obj\"\n{extra}")
+}
+
+fn fixture(name: &str, toml: &str, obj: &str) -> Fixture {
+    Fixture::new(name, &[("scene.toml", toml), ("room.obj", obj), ("room.mtl", MTL)])
+}
+
+#[test]
+fn a_good_minimal_scene_loads() {
+    let f = fixture("good", &scene_toml(""), OBJ);
+    let loaded = f.load().unwrap();
+    assert_eq!(loaded.scene.materials.len(), 2);
+    assert_eq!(loaded.scene.windows.len(), 1);
+    assert!((loaded.scene.windows[0].area - 0.5).abs() < 1e-6);
+    assert_eq!(loaded.scene.material(loaded.scene.windows[0].material).kind, MaterialKind::Glass { transmittance: 0.88 });
+}
+
+#[test]
+fn missing_scene_file() {
+    let e = load_scene(Path::new("/nonexistent/scene.toml"), &no_panels()).unwrap_err();
+    assert_eq!(e.to_string(), "/nonexistent/scene.toml: cannot read scene file: not found");
+}
+
+#[test]
+fn malformed_toml_names_the_line() {
+    let f = fixture("malformed", &format!("{SITE}\n[model\nobj = \"room.obj\"\n"), OBJ);
+    let e = f.error();
+    assert_eq!(e.location.line, Some(6), "{e}");
+    assert!(e.to_string().starts_with(&format!("{}:6:", f.scene().display())), "{e}");
+}
+
+#[test]
+fn missing_keys_and_out_of_range_site_values_name_the_key() {
+    let f = fixture("no_obj", &format!("{SITE}\n[model]\nup = \"z\"\n"), OBJ);
+    assert!(f.error().to_string().contains("missing field `obj`"), "{}", f.error());
+    let f = fixture("latitude", &scene_toml("").replace("42.36", "142.0"), OBJ);
+    let e = f.error();
+    assert_eq!((e.location.line, e.location.key.as_deref()), (Some(3), Some("site.latitude")), "{e}");
+    let f = fixture("up", &scene_toml("up = \"x\"\n"), OBJ);
+    assert_eq!(f.error().location.key.as_deref(), Some("model.up"));
+    let f = fixture("north", &scene_toml("north = [0.0, 0.0, 1.0]\n"), OBJ);
+    assert!(f.error().to_string().contains("model.north: north must not be parallel"), "{}", f.error());
+}
+
+#[test]
+fn missing_obj_names_the_scene_key() {
+    let f = Fixture::new("missing_obj", &[("scene.toml", &scene_toml(""))]);
+    let e = f.error();
+    assert_eq!(e.location.file, f.scene());
+    assert_eq!((e.location.line, e.location.key.as_deref()), (Some(8), Some("model.obj")), "{e}");
+    assert!(e.message.contains("room.obj") && e.message.contains("not found"), "{e}");
+}
+
+#[test]
+fn missing_mtl_names_the_obj_line() {
+    let f = Fixture::new("missing_mtl", &[("scene.toml", &scene_toml("")), ("room.obj", OBJ)]);
+    let e = f.error();
+    assert_eq!(e.location.file, f.dir.join("room.obj"));
+    assert_eq!(e.location.line, Some(1));
+    assert!(e.message.contains("room.mtl") && e.message.contains("not found"), "{e}");
+}
+
+#[test]
+fn unknown_material_kind() {
+    let f = fixture("kind", &scene_toml("\n[materials.wall]\nkind = \"difuse\"\nreflectance = 0.5\n"), OBJ);
+    let e = f.error();
+    assert_eq!((e.location.line, e.location.key.as_deref()), (Some(11), Some("materials.wall.kind")), "{e}");
+    assert!(e.message.contains("unknown material kind 'difuse'"), "{e}");
+}
+
+#[test]
+fn material_values_are_checked() {
+    let f = fixture("rho", &scene_toml("\n[materials.wall]\nkind = \"diffuse\"\nreflectance = 1.5\n"), OBJ);
+    assert_eq!(f.error().location.key.as_deref(), Some("materials.wall.reflectance"));
+    let f = fixture("extra", &scene_toml("\n[materials.wall]\nkind = \"diffuse\"\nreflectance = 0.5\ncolour = 1\n"), OBJ);
+    assert_eq!(f.error().location.key.as_deref(), Some("materials.wall.colour"));
+    let f = fixture("undefined", &scene_toml(""), &OBJ.replace("usemtl glass", "usemtl brick"));
+    let e = f.error();
+    assert_eq!((e.location.file.clone(), e.location.line), (f.dir.join("room.obj"), Some(8)), "{e}");
+    assert!(e.message.contains("'brick'"), "{e}");
+}
+
+#[test]
+fn unused_scene_material_is_a_warning() {
+    let f = fixture("unused", &scene_toml("\n[materials.marble]\nkind = \"diffuse\"\nreflectance = 0.7\n"), OBJ);
+    let loaded = f.load().unwrap();
+    assert_eq!(loaded.warnings.len(), 1);
+    let w = &loaded.warnings[0];
+    assert_eq!((w.location.line, w.location.key.as_deref()), (Some(10), Some("materials.marble")), "{w}");
+    assert!(w.message.contains("no face of") && w.message.contains("'marble'"), "{w}");
+}
+
+#[test]
+fn unregistered_panel() {
+    let toml = scene_toml("\n[materials.glass]\nkind = \"panel\"\npanel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n");
+    let f = fixture("panel", &toml, OBJ);
+    let e = f.error();
+    assert_eq!((e.location.line, e.location.key.as_deref()), (Some(12), Some("materials.glass.panel")), "{e}");
+    assert!(e.message.contains("no panel named 'prismatic' is registered"), "{e}");
+    // Once a plugin has registered the name, the same file loads and keeps the
+    // panel's own parameters for it.
+    let panels: PanelNames = ["prismatic".to_string()].into();
+    let loaded = load_scene(&f.scene(), &panels).unwrap();
+    let glass = loaded.scene.materials.iter().find(|m| m.name == "glass").unwrap();
+    match &glass.kind {
+        MaterialKind::Panel { panel, parameters, .. } => {
+            assert_eq!(panel, "prismatic");
+            assert!(parameters.contains_key("facet_angles"));
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(loaded.scene.windows.len(), 1);
+}
+
+#[test]
+fn non_finite_coordinates() {
+    let f = fixture("nan", &scene_toml(""), &OBJ.replace("v 1 1 0", "v 1 nan 0"));
+    let e = f.error();
+    assert_eq!((e.location.file.clone(), e.location.line), (f.dir.join("room.obj"), Some(4)), "{e}");
+    assert!(e.message.contains("non-finite"), "{e}");
+    let f = fixture("inf", &scene_toml(""), &OBJ.replace("v 1 0 0", "v inf 0 0"));
+    assert_eq!(f.error().location.line, Some(3));
+    let sensor = "\n[[sensors]]\nname = \"s\"\nposition = [0.5, nan, 0.8]\nnormal = [0.0, 0.0, 1.0]\n";
+    let f = fixture("nan_sensor", &scene_toml(sensor), OBJ);
+    let e = f.error();
+    assert_eq!((e.location.line, e.location.key.as_deref()), (Some(12), Some("sensors[0].position")), "{e}");
+}
+
+#[test]
+fn degenerate_triangles_are_dropped_with_a_count() {
+    let obj = format!("{OBJ}v 2 0 0\nv 3 0 0\nf 1 5 6\nf 2 2 3\n");
+    let f = fixture("degenerate", &scene_toml(""), &obj);
+    let loaded = f.load().unwrap();
+    assert_eq!(loaded.scene.triangles.len(), 2);
+    assert_eq!(loaded.warnings.len(), 1);
+    assert!(loaded.warnings[0].message.contains("dropped 2 degenerate"), "{}", loaded.warnings[0]);
+}
+
+#[test]
+fn obj_without_faces() {
+    let f = fixture("no_faces", &scene_toml(""), "mtllib room.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\n");
+    let e = f.error();
+    assert_eq!(e.to_string(), format!("{}: the model has no faces", f.dir.join("room.obj").display()));
+    let f = fixture("only_degenerate", &scene_toml(""), "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+    assert!(f.error().message.contains("no faces with a non-zero area"));
+}
+
+#[test]
+fn sensor_with_zero_normal() {
+    let sensor = "\n[[sensors]]\nname = \"desk\"\nposition = [0.5, 0.5, 0.8]\nnormal = [0.0, 0.0, 0.0]\n";
+    let f = fixture("zero_normal", &scene_toml(sensor), OBJ);
+    let e = f.error();
+    assert_eq!((e.location.line, e.location.key.as_deref()), (Some(13), Some("sensors[0].normal")), "{e}");
+    assert!(e.message.contains("zero"), "{e}");
+}
+
+#[test]
+fn sensor_names_are_unique_and_grids_non_empty() {
+    let twice = "\n[[sensors]]\nname = \"a\"\nposition = [0, 0, 1]\nnormal = [0, 0, 1]\n".repeat(2);
+    let f = fixture("duplicate", &scene_toml(&twice), OBJ);
+    assert!(f.error().message.contains("duplicate sensor name 'a'"));
+    let grid = "\n[[sensor_grids]]\nname = \"g\"\nmin = [0, 0]\nmax = [0.2, 1]\nheight = 0.8\nspacing = 0.5\n";
+    let f = fixture("empty_grid", &scene_toml(grid), OBJ);
+    assert_eq!(f.error().location.key.as_deref(), Some("sensor_grids[0].max"));
+}
+
+// ---- command line ------------------------------------------------------------
+
+fn heliodon(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_heliodon"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run heliodon");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn info_summarises_each_bundled_scene() {
+    let (code, out, err) = heliodon(&["info", "assets/scenes/test_room/scene.toml"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.is_empty(), "{err}");
+    for expected in [
+        "scene      Small test room",
+        "triangles  80",
+        "  diffuse  3: ",
+        "  glass    1: glass τ=0.88",
+        "windows    6, 4.59 m² in all",
+        "facing S (azimuth 180°)",
+        "sensors    65 (3 point, 2 area, grids: workplane 60)",
+        "latitude 42.3600°, longitude -71.0600°, UTC-5",
+    ] {
+        assert!(out.contains(expected), "missing {expected:?} in\n{out}");
+    }
+    let patches: usize = out
+        .lines()
+        .find_map(|l| l.strip_prefix("patches    "))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .expect("patch line");
+    assert!(patches > 400, "{out}");
+    let (code, out, _) = heliodon(&["info", "assets/scenes/office/scene.toml"]);
+    assert_eq!(code, 0);
+    assert!(out.contains("windows    12, 24.88 m² in all") && out.contains("facing W (azimuth 270°)"), "{out}");
+    let (code, out, _) = heliodon(&["info", "assets/scenes/living_room/scene.toml"]);
+    assert_eq!(code, 0);
+    assert!(out.contains("up Y, scale 0.01 m/unit") && out.contains("windows    16"), "{out}");
+}
+
+#[test]
+fn cli_errors_are_one_line_and_non_zero() {
+    let f = fixture("cli_kind", &scene_toml("\n[materials.wall]\nkind = \"stone\"\n"), OBJ);
+    let scene = f.scene();
+    let (code, out, err) = heliodon(&["info", scene.to_str().unwrap()]);
+    assert_ne!(code, 0);
+    assert!(out.is_empty());
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.starts_with(&format!("error: {}:11: materials.wall.kind: unknown material kind 'stone'", scene.display())), "{err}");
+    let (code, _, err) = heliodon(&["info", "no/such/scene.toml"]);
+    assert_ne!(code, 0);
+    assert_eq!(err.trim_end(), "error: no/such/scene.toml: cannot read scene file: not found");
+    let (code, _, err) = heliodon(&["info", "assets/scenes/test_room/scene.toml", "--bogus"]);
+    assert_eq!(code, 2);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("--bogus"), "{err}");
+    let (code, _, err) = heliodon(&["info"]);
+    assert_eq!(code, 2);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    // Warnings go to stderr and do not fail the command.
+    let f = fixture("cli_warning", &scene_toml("\n[materials.marble]\nkind = \"diffuse\"\nreflectance = 0.7\n"), OBJ);
+    let (code, _, err) = heliodon(&["info", f.scene().to_str().unwrap()]);
+    assert_eq!(code, 0);
+    assert!(err.starts_with("warning: ") && err.contains("materials.marble"), "{err}");
+}
+
+#[test]
+fn help_lists_only_what_exists() {
+    let (code, out, _) = heliodon(&["--help"]);
+    assert_eq!(code, 0);
+    // Subcommands arrive with their features: none is listed before it exists.
+    let commands: Vec<&str> = out
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next())
+        .collect();
+    assert_eq!(commands, ["view", "info", "help"], "{out}");
+}
