@@ -1,7 +1,8 @@
 //! heliodon: a digital heliodon for daylighting design.
 //!
 //! Layers, from the bottom (see ARCHITECTURE.md):
-//! - science, plain Rust without Bevy types: [`site`], [`scene`];
+//! - science, plain Rust without Bevy types: [`site`], [`time`], [`scene`],
+//!   [`sun`], [`sky`];
 //! - the ECS layer: [`ecs`] ([`HeliodonPlugins`], runs headless);
 //! - drawing: [`render`]; the window and its input: [`viewer`];
 //! - the command line: [`cli`].
@@ -11,6 +12,9 @@ pub mod ecs;
 pub mod render;
 pub mod scene;
 pub mod site;
+pub mod sky;
+pub mod sun;
+pub mod time;
 pub mod viewer;
 
 use std::path::{Path, PathBuf};

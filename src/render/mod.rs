@@ -14,9 +14,13 @@ use crate::scene::{DEFAULT_FOV, MaterialKind, Scene, Viewpoint};
 
 pub struct HeliodonRenderPlugin;
 
+/// What shows where there is no model: a pale sky.
+pub const BACKGROUND: Color = Color::srgb(0.82, 0.86, 0.9);
+
 impl Plugin for HeliodonRenderPlugin {
     fn build(&self, app: &mut App) {
         app.insert_resource(GlobalAmbientLight { color: Color::WHITE, brightness: 400.0, ..default() })
+            .insert_resource(ClearColor(BACKGROUND))
             .add_systems(Startup, spawn_key_light)
             .add_systems(Update, spawn_scene_meshes.after(HeliodonSystems::SpawnScene));
     }

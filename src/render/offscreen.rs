@@ -113,7 +113,6 @@ fn spawn_camera(
     ));
     commands.spawn((
         Camera3d::default(),
-        Camera { clear_color: ClearColorConfig::Custom(Color::srgb(0.82, 0.86, 0.9)), ..default() },
         RenderTarget::Image(target.clone().into()),
         Projection::Perspective(PerspectiveProjection { fov: view.fov.to_radians(), ..default() }),
         Transform::from_translation(view.eye).looking_at(view.target, Vec3::Z),
