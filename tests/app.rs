@@ -135,3 +135,44 @@ fn render_smoke_test_draws_the_model() {
     levels.dedup();
     assert!(levels.len() >= 4, "shades {levels:?}");
 }
+
+#[test]
+fn the_sun_and_sky_follow_the_clock_once_per_change() {
+    use heliodon::ecs::{LightChanged, SkyChoice, SolarTime, SunSky};
+    use heliodon::sky::{Sky, SkySpec};
+    use heliodon::sun::solar_position;
+    use heliodon::time::{LocalDateTime, TimeOfDay};
+
+    let mut app = headless_app();
+    let site = heliodon::site::Site::new(42.36, -71.06, -5.0);
+    app.world_mut().insert_resource(Site(site));
+    let messages = |app: &mut App| app.world_mut().resource_mut::<Messages<LightChanged>>().drain().count();
+    app.update();
+    assert_eq!(messages(&mut app), 1, "the first sun and sky");
+    for _ in 0..3 {
+        app.update();
+    }
+    assert_eq!(messages(&mut app), 0, "nothing changed, nothing recomputed");
+
+    let date = app.world().resource::<SolarTime>().0.date;
+    for (k, hours) in [9.0, 12.5, 16.25].into_iter().enumerate() {
+        let when = LocalDateTime { date, time: TimeOfDay::from_hours(hours).unwrap() };
+        app.world_mut().resource_mut::<SolarTime>().0 = when;
+        app.update();
+        app.update();
+        assert_eq!(messages(&mut app), 1, "one update for the change to {hours} h");
+        let state = app.world().resource::<SunSky>();
+        let expected = solar_position(&site, &when);
+        assert_eq!(state.sun, expected);
+        assert_eq!(state.generation, k as u64 + 1);
+        let sky = Sky::new(&SkySpec::Clear { turbidity: 2.45 }, expected.altitude, expected.azimuth, 0.2, date.day_of_year()).unwrap();
+        assert_eq!(state.sky, sky);
+        assert_eq!(state.patch_radiance, state.patches.integrate(&sky));
+        assert_eq!(state.patch_radiance.len(), 2305);
+    }
+    // A new sky is one more update, and its light shows.
+    app.world_mut().resource_mut::<SkyChoice>().0 = SkySpec::Overcast;
+    app.update();
+    assert_eq!(messages(&mut app), 1);
+    assert!(app.world().resource::<SunSky>().sky.sun.is_none());
+}

@@ -306,3 +306,67 @@ fn bad_sky_input_is_one_clear_line() {
     }
     assert_eq!(SkySpec::parse("turbid", &none).unwrap(), SkySpec::Clear { turbidity: 5.0 });
 }
+
+// ---- command line -----------------------------------------------------------------------
+
+fn heliodon(args: &[&str]) -> (i32, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_heliodon")).args(args).output().expect("run heliodon");
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+const BOSTON: [&str; 6] = ["--latitude", "42.36", "--longitude", "-71.06", "--timezone", "-5"];
+
+#[test]
+fn sun_command_prints_the_contract_formats() {
+    let mut args = vec!["sun"];
+    args.extend(BOSTON);
+    args.extend(["--date", "2026-03-21", "--time", "12:00"]);
+    let site = Site::new(42.36, -71.06, -5.0);
+    let expected = solar_position(&site, &LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() });
+
+    let (code, out, err) = heliodon(&[args.as_slice(), &["--format", "csv"]].concat());
+    assert_eq!(code, 0, "{err}");
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], "altitude_deg,azimuth_deg");
+    assert_eq!(lines.len(), 2);
+    let values: Vec<f64> = lines[1].split(',').map(|v| v.parse().unwrap()).collect();
+    assert!((values[0] - expected.altitude).abs() < 1e-6 && (values[1] - expected.azimuth).abs() < 1e-6);
+
+    let (code, out, _) = heliodon(&[args.as_slice(), &["--format", "json"]].concat());
+    assert_eq!(code, 0);
+    assert_eq!(out.trim(), format!("{{\"altitude_deg\": {:.6}, \"azimuth_deg\": {:.6}}}", expected.altitude, expected.azimuth));
+
+    let (code, out, _) = heliodon(&args);
+    assert_eq!(code, 0);
+    assert!(out.contains(&format!("altitude   {:9.4}°", expected.altitude)), "{out}");
+
+    let mut day = vec!["sun"];
+    day.extend(BOSTON);
+    day.extend(["--date", "2026-03-21", "--day", "--format", "csv"]);
+    let (code, out, _) = heliodon(&day);
+    assert_eq!(code, 0);
+    let rows: Vec<&str> = out.lines().collect();
+    assert_eq!(rows[0], "event,time,altitude_deg,azimuth_deg");
+    assert!(rows[1].starts_with("sunrise,05:45:42,") && rows[2].starts_with("noon,11:51:19,") && rows[3].starts_with("sunset,17:57:41,"), "{out}");
+}
+
+#[test]
+fn sun_command_rejects_bad_input_in_one_line() {
+    let cases: [(&[&str], &str); 8] = [
+        (&["--latitude", "95", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21", "--time", "12:00"], "--latitude"),
+        (&["--latitude", "10", "--longitude", "-181", "--timezone", "0", "--date", "2026-03-21", "--time", "12:00"], "--longitude"),
+        (&["--latitude", "10", "--longitude", "0", "--timezone", "-15", "--date", "2026-03-21", "--time", "12:00"], "--timezone"),
+        (&["--latitude", "10", "--longitude", "0", "--timezone", "0", "--date", "2026-02-30", "--time", "12:00"], "February 2026 has 28 days"),
+        (&["--latitude", "10", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21", "--time", "24:01"], "outside 00:00-24:00"),
+        (&["--latitude", "10", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21", "--time", "7pm"], "--time"),
+        (&["--latitude", "10", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21"], "--time"),
+        (&["--latitude", "nan", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21", "--time", "12:00"], "--latitude"),
+    ];
+    for (args, expected) in cases {
+        let (code, out, err) = heliodon(&[&["sun"], args].concat());
+        assert_eq!(code, 2, "{args:?}");
+        assert!(out.is_empty());
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.starts_with("error: ") && err.contains(expected), "{args:?}: {err}");
+    }
+}

@@ -1,11 +1,12 @@
 //! The ECS layer: heliodon's state as Bevy resources and entities, updated by
-//! systems in named sets. [`HeliodonPlugins`] is everything that simulates;
+//! systems in named sets ([`HeliodonSystems`], in that order each frame). [`HeliodonPlugins`] is everything that simulates;
 //! it runs headless (`MinimalPlugins` + `AssetPlugin`) as well as in the
 //! viewer. Drawing lives in [`crate::render`], windows and input in
 //! [`crate::viewer`].
 
 mod scene_asset;
 mod scene_plugin;
+mod sun_sky;
 
 use bevy::app::PluginGroupBuilder;
 use bevy::prelude::*;
@@ -15,13 +16,14 @@ pub use scene_plugin::{
     ActiveScene, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, ScenePlugin, SceneRoot, SceneSpawned,
     SceneSurface, SceneSensor, SceneWindow, Site,
 };
+pub use sun_sky::{LightChanged, SkyChoice, SkyRejected, SkySubdivision, SolarTime, SunSky, SunSkyPlugin};
 
 /// The simulation plugins, in dependency order.
 pub struct HeliodonPlugins;
 
 impl PluginGroup for HeliodonPlugins {
     fn build(self) -> PluginGroupBuilder {
-        PluginGroupBuilder::start::<Self>().add(ScenePlugin)
+        PluginGroupBuilder::start::<Self>().add(ScenePlugin).add(SunSkyPlugin)
     }
 }
 
@@ -32,4 +34,6 @@ pub enum HeliodonSystems {
     LoadScene,
     /// Replace the scene entities once a load has finished.
     SpawnScene,
+    /// Recompute the sun and sky when the site, time or sky changed.
+    UpdateSunSky,
 }

@@ -24,7 +24,10 @@ impl Plugin for ScenePlugin {
             .add_message::<OpenScene>()
             .add_message::<SceneSpawned>()
             .add_message::<SceneLoadFailed>()
-            .configure_sets(Update, (HeliodonSystems::LoadScene, HeliodonSystems::SpawnScene).chain())
+            .configure_sets(
+                Update,
+                (HeliodonSystems::LoadScene, HeliodonSystems::SpawnScene, HeliodonSystems::UpdateSunSky).chain(),
+            )
             .add_systems(Update, request_scene.in_set(HeliodonSystems::LoadScene))
             .add_systems(Update, (spawn_loaded_scene, report_failed_load).in_set(HeliodonSystems::SpawnScene));
     }
