@@ -9,7 +9,9 @@ use clap::{Parser, Subcommand};
 
 use crate::ecs::PanelRegistry;
 use crate::scene::{self, MaterialKind, Scene};
+use crate::light::{LightModel, LightSettings, Lighting};
 use crate::site::Site;
+use crate::sky::{Sky, SkyInputs, SkySpec};
 use crate::sun::{self, SolarPosition};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
 
@@ -40,6 +42,9 @@ pub enum Command {
         /// Scene file (TOML)
         scene: PathBuf,
     },
+    /// Illuminance at the scene's sensors (lux): total, direct sun, direct sky, indirect
+    #[command(allow_negative_numbers = true)]
+    Sensors(SensorsArgs),
     /// Sun position (NREL SPA) for a site and a local standard time, or the day's sunrise, noon and sunset
     #[command(allow_negative_numbers = true)]
     Sun(SunArgs),
@@ -76,6 +81,58 @@ pub struct SunArgs {
     pub temperature: f64,
     #[arg(long, value_enum, default_value_t = Format::Table)]
     pub format: Format,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct SensorsArgs {
+    /// Scene file (TOML)
+    pub scene: PathBuf,
+    /// Local dates, YYYY-MM-DD, comma-separated for several
+    #[arg(long, value_parser = Date::parse, value_delimiter = ',', required = true)]
+    pub date: Vec<Date>,
+    /// Local standard times, HH:MM, comma-separated for several
+    #[arg(long, value_parser = TimeOfDay::parse, value_delimiter = ',', required = true)]
+    pub time: Vec<TimeOfDay>,
+    #[command(flatten)]
+    pub sky: SkyArgs,
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    pub format: Format,
+}
+
+/// The sky flags shared by the commands that light a scene.
+#[derive(clap::Args, Debug, Clone)]
+pub struct SkyArgs {
+    /// clear, turbid, intermediate, overcast, uniform, perez or cie:1 … cie:15
+    #[arg(long, default_value = "clear")]
+    pub sky: String,
+    /// Direct normal irradiance, W/m² (perez)
+    #[arg(long, value_name = "W")]
+    pub dni: Option<f64>,
+    /// Diffuse horizontal irradiance, W/m² (perez)
+    #[arg(long, value_name = "W")]
+    pub dhi: Option<f64>,
+    /// Direct normal illuminance, lux (perez, cie:N)
+    #[arg(long, value_name = "LUX")]
+    pub direct_lux: Option<f64>,
+    /// Diffuse horizontal illuminance, lux (perez, cie:N)
+    #[arg(long, value_name = "LUX")]
+    pub diffuse_lux: Option<f64>,
+    /// Turbidity of the clear and intermediate skies (default 2.45; turbid is 5)
+    #[arg(long)]
+    pub turbidity: Option<f64>,
+}
+
+impl SkyArgs {
+    pub fn spec(&self) -> Result<SkySpec, String> {
+        let inputs = SkyInputs {
+            direct_normal: self.dni,
+            diffuse_horizontal: self.dhi,
+            direct_illuminance: self.direct_lux,
+            diffuse_illuminance: self.diffuse_lux,
+            turbidity: self.turbidity,
+        };
+        SkySpec::parse(&self.sky, &inputs).map_err(|e| format!("--sky {}: {e}", self.sky))
+    }
 }
 
 #[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -138,11 +195,88 @@ pub fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         },
+        Some(Command::Sensors(args)) => match sensors(&args) {
+            Ok(text) => {
+                print!("{text}");
+                ExitCode::SUCCESS
+            }
+            Err(error) => {
+                eprintln!("error: {error}");
+                ExitCode::FAILURE
+            }
+        },
         Some(Command::Sun(args)) => {
             print!("{}", sun_report(&args));
             ExitCode::SUCCESS
         }
     }
+}
+
+/// The `sensors` command: one precomputation, then every date × time.
+pub fn sensors(args: &SensorsArgs) -> Result<String, String> {
+    let spec = args.sky.spec()?;
+    let loaded = scene::load_scene(&args.scene, &PanelRegistry::default().names()).map_err(|e| e.to_string())?;
+    for warning in &loaded.warnings {
+        eprintln!("warning: {warning}");
+    }
+    let scene = std::sync::Arc::new(loaded.scene);
+    let site = scene.site;
+    let model = LightModel::precompute(scene.clone(), LightSettings::default())?;
+    let cases: Vec<LocalDateTime> =
+        args.date.iter().flat_map(|&date| args.time.iter().map(move |&time| LocalDateTime { date, time })).collect();
+    let several = cases.len() > 1;
+    let mut out = String::new();
+    let mut previous: Option<Lighting> = None;
+    if args.format == Format::Csv {
+        let _ = writeln!(out, "{}name,illuminance_lux,direct_sun_lux,direct_sky_lux,indirect_lux", if several { "date,time," } else { "" });
+    }
+    let mut json = Vec::new();
+    for when in cases {
+        let position = sun::solar_position(&site, &when);
+        let sky = Sky::new(&spec, position.altitude, position.azimuth, site.ground_reflectance, when.date.day_of_year())
+            .map_err(|e| format!("--sky {} on {} {}: {e}", args.sky.sky, when.date, when.time))?;
+        let lighting = model.solve(&sky, previous.as_ref());
+        match args.format {
+            Format::Csv => {
+                for r in &lighting.sensors {
+                    let prefix = if several { format!("{},{},", when.date, when.time) } else { String::new() };
+                    let _ = writeln!(out, "{prefix}{},{:.1},{:.1},{:.1},{:.1}", r.name, r.total, r.direct_sun, r.direct_sky, r.indirect);
+                }
+            }
+            Format::Json => {
+                let rows: Vec<String> = lighting
+                    .sensors
+                    .iter()
+                    .map(|r| {
+                        format!(
+                            "{{\"name\": {:?}, \"illuminance_lux\": {:.1}, \"direct_sun_lux\": {:.1}, \"direct_sky_lux\": {:.1}, \"indirect_lux\": {:.1}}}",
+                            r.name, r.total, r.direct_sun, r.direct_sky, r.indirect
+                        )
+                    })
+                    .collect();
+                json.push(format!(
+                    "{{\"date\": \"{}\", \"time\": \"{}\", \"sun_altitude_deg\": {:.4}, \"sun_azimuth_deg\": {:.4}, \"sky\": \"{}\", \"sensors\": [{}]}}",
+                    when.date, when.time, position.altitude, position.azimuth, args.sky.sky, rows.join(", ")
+                ));
+            }
+            Format::Table => {
+                let _ = writeln!(
+                    out,
+                    "{} {}  sun altitude {:.2}°, azimuth {:.2}°  sky {}",
+                    when.date, when.time, position.altitude, position.azimuth, args.sky.sky
+                );
+                let _ = writeln!(out, "{:<20} {:>10} {:>10} {:>10} {:>10}", "sensor", "total lx", "sun lx", "sky lx", "indirect lx");
+                for r in &lighting.sensors {
+                    let _ = writeln!(out, "{:<20} {:>10.1} {:>10.1} {:>10.1} {:>10.1}", r.name, r.total, r.direct_sun, r.direct_sky, r.indirect);
+                }
+            }
+        }
+        previous = Some(lighting);
+    }
+    if args.format == Format::Json {
+        let _ = writeln!(out, "{}", if several { format!("[{}]", json.join(", ")) } else { json.concat() });
+    }
+    Ok(out)
 }
 
 /// The `sun` command's output.

@@ -2,13 +2,14 @@
 //!
 //! Layers, from the bottom (see ARCHITECTURE.md):
 //! - science, plain Rust without Bevy types: [`site`], [`time`], [`scene`],
-//!   [`sun`], [`sky`];
+//!   [`sun`], [`sky`], [`light`];
 //! - the ECS layer: [`ecs`] ([`HeliodonPlugins`], runs headless);
 //! - drawing: [`render`]; the window and its input: [`viewer`];
 //! - the command line: [`cli`].
 
 pub mod cli;
 pub mod ecs;
+pub mod light;
 pub mod render;
 pub mod scene;
 pub mod site;

@@ -130,6 +130,23 @@ impl SkyPatches {
         out
     }
 
+    /// The sphere's bin of a direction: sky patches first, then the same
+    /// layout mirrored below the horizon for the ground glow (2 × len bins).
+    pub fn sphere_bin(&self, d: DVec3) -> usize {
+        let up = DVec3::new(d.x, d.y, d.z.abs().max(1e-12));
+        let patch = self.patch_of(up).expect("direction above the horizon");
+        if d.z > 0.0 { patch } else { self.len() + patch }
+    }
+
+    /// Mean radiance of every sphere bin ([`Self::sphere_bin`]) under `sky`, sun excluded.
+    pub fn integrate_sphere_into(&self, sky: &Sky, out: &mut Vec<f64>) {
+        self.integrate_into(sky, out);
+        out.extend(self.sample_ranges.iter().map(|range| {
+            let cells = &self.samples[range.start as usize..range.end as usize];
+            cells.iter().map(|&d| sky.radiance(DVec3::new(d.x, d.y, -d.z))).sum::<f64>() / cells.len() as f64
+        }));
+    }
+
     /// Total solid angle: 2π up to rounding.
     pub fn total_solid_angle(&self) -> f64 {
         self.patches.iter().map(|p| p.solid_angle).sum()

@@ -1,0 +1,490 @@
+//! The light engine: the light factored as the thesis does (chapter 3).
+//!
+//! - Precomputation, once per geometry ([`LightModel::precompute`]): from
+//!   every side of every diffuse patch and from every sensor, cosine-weighted
+//!   hemisphere rays are followed through glass (Radiance's `glass`:
+//!   transmitted and reflected) until they reach a diffuse patch (a form
+//!   factor) or leave the model (a daylight coefficient to a sky or ground
+//!   bin, Reinhart MF:n above the horizon and its mirror below).
+//! - Relighting, per sun and sky ([`LightModel::solve`]): direct sun by shadow
+//!   rays through the windows, direct sky as a sparse product of coefficients
+//!   and bin radiances, and indirect light by Jacobi iterations over the form
+//!   factors, three channels per patch side (sun, sky, indirect, RGB),
+//!   warm-started from a previous solution. Sensors gather through their own
+//!   rays, never from the nearest patch.
+//!
+//! Results are deterministic: every receiver has its own seeded generator.
+//! Plain Rust, no Bevy types.
+
+mod bvh;
+mod glass;
+mod sampling;
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use glam::DVec3;
+
+pub use glass::Glass;
+
+use crate::scene::{MaterialKind, Scene, Sensor};
+use crate::sky::{LUMINOUS_EFFICACY, Sky, SkyPatches};
+use bvh::Tracer;
+use sampling::{Rng, cosine_directions, point_on_triangle};
+
+/// Knobs of the simulation; the defaults reach the accuracy targets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightSettings {
+    /// Hemisphere rays from each side of each patch (form factors, sky coefficients).
+    pub rays_per_patch: usize,
+    /// Hemisphere rays from each sensor point.
+    pub rays_per_sensor: usize,
+    /// Shadow rays toward the sun per patch.
+    pub sun_samples_per_patch: usize,
+    /// Points per side of an area sensor's grid for the direct sun (sky and
+    /// indirect use a 4 × 4 grid).
+    pub area_sensor_sun_grid: usize,
+    /// Reinhart MF:n of the sky bins.
+    pub sky_subdivision: u32,
+    /// Jacobi iterations at most.
+    pub max_iterations: usize,
+    /// Stop when no patch's indirect irradiance changes by more than this
+    /// fraction of the mean irradiance.
+    pub tolerance: f64,
+}
+
+impl Default for LightSettings {
+    fn default() -> Self {
+        Self {
+            rays_per_patch: 256,
+            rays_per_sensor: 4096,
+            sun_samples_per_patch: 16,
+            area_sensor_sun_grid: 32,
+            sky_subdivision: 4,
+            max_iterations: 200,
+            tolerance: 1e-4,
+        }
+    }
+}
+
+impl LightSettings {
+    /// One line naming the first setting that cannot work.
+    pub fn check(&self) -> Result<(), String> {
+        let positive = [
+            (self.rays_per_patch, "rays_per_patch"),
+            (self.rays_per_sensor, "rays_per_sensor"),
+            (self.sun_samples_per_patch, "sun_samples_per_patch"),
+            (self.area_sensor_sun_grid, "area_sensor_sun_grid"),
+            (self.max_iterations, "max_iterations"),
+        ];
+        if let Some((_, name)) = positive.iter().find(|(v, _)| *v == 0) {
+            return Err(format!("lighting setting {name} must be at least 1"));
+        }
+        if self.sky_subdivision == 0 || self.sky_subdivision > 16 {
+            return Err(format!("sky subdivision MF:{} is outside 1-16", self.sky_subdivision));
+        }
+        if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
+            return Err(format!("tolerance {} must lie in (0, 1)", self.tolerance));
+        }
+        Ok(())
+    }
+}
+
+/// Offset of ray origins off their surface, metres.
+const SURFACE_OFFSET: f64 = 1e-4;
+/// Glass interactions followed along one ray.
+const MAX_GLASS_DEPTH: u32 = 4;
+/// Branches carrying less than this share of a ray are dropped.
+const MIN_WEIGHT: f64 = 1e-4;
+/// Sensors closer than this to a surface behind them read as lifted this far.
+const SENSOR_LIFT: f64 = 0.01;
+
+/// Where a receiver's hemisphere light comes from: bins of the sky sphere and
+/// patch sides, each with its share (the shares of all rays sum to at most 1).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Gather {
+    pub bins: Vec<(u32, f32)>,
+    pub sides: Vec<(u32, f32)>,
+}
+
+impl Gather {
+    fn from_raw(mut bins: Vec<(u32, f64)>, mut sides: Vec<(u32, f64)>, rays: usize) -> Self {
+        let merge = |v: &mut Vec<(u32, f64)>| -> Vec<(u32, f32)> {
+            v.sort_by_key(|e| e.0);
+            let mut out: Vec<(u32, f32)> = Vec::new();
+            for &(i, w) in v.iter() {
+                match out.last_mut() {
+                    Some(last) if last.0 == i => last.1 += (w / rays as f64) as f32,
+                    _ => out.push((i, (w / rays as f64) as f32)),
+                }
+            }
+            out
+        };
+        Self { bins: merge(&mut bins), sides: merge(&mut sides) }
+    }
+}
+
+/// A patch side: index `2·patch` for the side its normal points to, `2·patch + 1` for the other.
+pub fn side_of(patch: u32, back: bool) -> u32 {
+    2 * patch + u32::from(back)
+}
+
+/// What a material does to a ray that meets it.
+#[derive(Debug, Clone, Copy)]
+enum Surface {
+    Diffuse([f64; 3]),
+    Glass(Glass),
+    /// A panel: plain pass-through until panel models arrive.
+    PassThrough,
+}
+
+/// Precomputed light transport for one scene.
+pub struct LightModel {
+    pub scene: Arc<Scene>,
+    pub settings: LightSettings,
+    pub bins: SkyPatches,
+    tracer: Tracer,
+    surfaces: Vec<Surface>,
+    /// Per patch side (2 per patch; empty for glass and panels).
+    side_gathers: Vec<Gather>,
+    sensors: Vec<SensorGeometry>,
+}
+
+struct SensorGeometry {
+    /// Points that gather sky and indirect light (one, or a 4 × 4 grid).
+    points: Vec<DVec3>,
+    /// Points whose direct sun is averaged.
+    sun_points: Vec<DVec3>,
+    normal: DVec3,
+    gather: Gather,
+}
+
+/// Irradiance (W/m²) on a patch side or sensor, by channel.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Channels {
+    pub sun: f64,
+    /// Sky and ground glow.
+    pub sky: f64,
+    /// Interreflected, RGB.
+    pub indirect: [f64; 3],
+}
+
+impl Channels {
+    /// Photometric indirect irradiance (Radiance's RGB weights).
+    pub fn indirect_luminous(&self) -> f64 {
+        let [r, g, b] = self.indirect;
+        0.265 * r + 0.670 * g + 0.065 * b
+    }
+}
+
+/// A sensor's reading in lux.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SensorReading {
+    pub name: String,
+    pub total: f64,
+    pub direct_sun: f64,
+    pub direct_sky: f64,
+    pub indirect: f64,
+}
+
+/// The light for one sun and sky.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lighting {
+    /// Per patch side (see [`side_of`]).
+    pub sides: Vec<Channels>,
+    pub sensors: Vec<SensorReading>,
+    /// Jacobi iterations used.
+    pub iterations: usize,
+}
+
+/// Maps `f` over `0..count` on all cores; the result does not depend on how
+/// the work is split.
+fn par_map<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(count.max(1));
+    let chunk = count.div_ceil(threads).max(1);
+    let f = &f;
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..count)
+            .step_by(chunk)
+            .map(|start| scope.spawn(move || (start..(start + chunk).min(count)).map(f).collect::<Vec<T>>()))
+            .collect();
+        handles.into_iter().flat_map(|h| h.join().expect("light worker panicked")).collect()
+    })
+}
+
+impl LightModel {
+    /// Traces everything that does not depend on the sun and sky.
+    pub fn precompute(scene: Arc<Scene>, settings: LightSettings) -> Result<Self, String> {
+        settings.check()?;
+        let tracer = Tracer::new(&scene.patches);
+        let surfaces = scene
+            .materials
+            .iter()
+            .map(|m| match &m.kind {
+                MaterialKind::Diffuse { reflectance } => Surface::Diffuse(reflectance.0.map(f64::from)),
+                MaterialKind::Glass { transmittance } => Surface::Glass(Glass::from_transmittance(f64::from(*transmittance))),
+                MaterialKind::Panel { .. } => Surface::PassThrough,
+            })
+            .collect();
+        let mut model = Self {
+            bins: SkyPatches::reinhart(settings.sky_subdivision),
+            scene,
+            settings,
+            tracer,
+            surfaces,
+            side_gathers: Vec::new(),
+            sensors: Vec::new(),
+        };
+        let patches = &model.scene.patches.patches;
+        model.side_gathers = par_map(patches.len() * 2, |side| model.gather_patch_side(side));
+        let sensors = model.scene.sensors.clone();
+        model.sensors = par_map(sensors.len(), |i| model.sensor_geometry(i, &sensors[i]));
+        Ok(model)
+    }
+
+    fn surface_of_patch(&self, patch: u32) -> Surface {
+        self.surfaces[self.scene.patches.patches[patch as usize].material as usize]
+    }
+
+    fn patch_normal(&self, patch: u32) -> DVec3 {
+        self.scene.patches.patches[patch as usize].normal.as_dvec3()
+    }
+
+    /// Follows a ray through glass, adding what it reaches to `bins`/`sides`.
+    fn follow(&self, origin: DVec3, dir: DVec3, weight: f64, depth: u32, bins: &mut Vec<(u32, f64)>, sides: &mut Vec<(u32, f64)>) {
+        match self.tracer.closest(origin, dir, 1e-6) {
+            None => bins.push((self.bins.sphere_bin(dir) as u32, weight)),
+            Some(hit) => {
+                let normal = self.patch_normal(hit.patch);
+                let cos = dir.dot(normal);
+                let point = origin + dir * hit.distance;
+                match self.surface_of_patch(hit.patch) {
+                    Surface::Diffuse(_) => sides.push((side_of(hit.patch, cos > 0.0), weight)),
+                    Surface::PassThrough if depth < MAX_GLASS_DEPTH => {
+                        self.follow(point + dir * SURFACE_OFFSET, dir, weight, depth + 1, bins, sides)
+                    }
+                    Surface::Glass(glass) if depth < MAX_GLASS_DEPTH => {
+                        let (t, r) = glass.at(cos);
+                        if weight * t > MIN_WEIGHT {
+                            self.follow(point + dir * SURFACE_OFFSET, dir, weight * t, depth + 1, bins, sides);
+                        }
+                        if weight * r > MIN_WEIGHT {
+                            let reflected = dir - 2.0 * cos * normal;
+                            self.follow(point + reflected * SURFACE_OFFSET, reflected, weight * r, depth + 1, bins, sides);
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
+
+    /// How much of the sun reaches `point` (through glass; 0 when blocked).
+    fn sun_transmittance(&self, point: DVec3, sun: DVec3) -> f64 {
+        let mut origin = point;
+        let mut transmittance = 1.0;
+        for _ in 0..=MAX_GLASS_DEPTH {
+            let Some(hit) = self.tracer.closest(origin, sun, 1e-6) else { return transmittance };
+            match self.surface_of_patch(hit.patch) {
+                Surface::Diffuse(_) => return 0.0,
+                Surface::Glass(glass) => transmittance *= glass.at(sun.dot(self.patch_normal(hit.patch))).0,
+                Surface::PassThrough => {}
+            }
+            origin += sun * (hit.distance + SURFACE_OFFSET);
+        }
+        0.0
+    }
+
+    fn gather_patch_side(&self, side: usize) -> Gather {
+        let patch_index = side / 2;
+        let patch = &self.scene.patches.patches[patch_index];
+        if !matches!(self.surfaces[patch.material as usize], Surface::Diffuse(_)) {
+            return Gather::default();
+        }
+        let normal = patch.normal.as_dvec3() * if side % 2 == 1 { -1.0 } else { 1.0 };
+        let triangles = self.patch_triangles(patch_index);
+        let mut rng = Rng::new(1, side as u64);
+        let directions = cosine_directions(normal, self.settings.rays_per_patch, &mut rng);
+        let (mut bins, mut sides) = (Vec::new(), Vec::new());
+        for dir in directions {
+            let point = sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET;
+            self.follow(point, dir, 1.0, 0, &mut bins, &mut sides);
+        }
+        Gather::from_raw(bins, sides, self.settings.rays_per_patch)
+    }
+
+    /// A patch's render triangles with their cumulative areas.
+    fn patch_triangles(&self, patch: usize) -> Vec<([DVec3; 3], f64)> {
+        let range = self.scene.patches.patches[patch].triangles.clone();
+        let mut total = 0.0;
+        self.scene.patches.triangles[range.start as usize..range.end as usize]
+            .iter()
+            .map(|t| {
+                let t = t.map(|v| v.as_dvec3());
+                total += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+                (t, total)
+            })
+            .collect()
+    }
+
+    fn sensor_geometry(&self, index: usize, sensor: &Sensor) -> SensorGeometry {
+        let normal = sensor.normal.as_dvec3();
+        let mut centre = sensor.position.as_dvec3();
+        // Lying on a surface (within the lift, facing away from it): lift it.
+        if let Some(hit) = self.tracer.closest(centre + normal * SENSOR_LIFT, -normal, 0.0)
+            && hit.distance <= SENSOR_LIFT * 1.01
+        {
+            centre += normal * (SENSOR_LIFT - (hit.distance - SENSOR_LIFT)).max(0.0);
+        }
+        let [u, v] = sensor.axes.map(|a| a.as_dvec3());
+        let grid = |n: usize| -> Vec<DVec3> {
+            let size = f64::from(sensor.size.unwrap_or(0.0));
+            (0..n * n)
+                .map(|k| {
+                    let (i, j) = ((k % n) as f64, (k / n) as f64);
+                    centre + u * size * ((i + 0.5) / n as f64 - 0.5) + v * size * ((j + 0.5) / n as f64 - 0.5)
+                })
+                .collect()
+        };
+        let (points, sun_points) = match sensor.size {
+            Some(_) => (grid(4), grid(self.settings.area_sensor_sun_grid)),
+            None => (vec![centre], vec![centre]),
+        };
+        let mut rng = Rng::new(2, index as u64);
+        let per_point = self.settings.rays_per_sensor.div_ceil(points.len());
+        let (mut bins, mut sides) = (Vec::new(), Vec::new());
+        for &point in &points {
+            for dir in cosine_directions(normal, per_point, &mut rng) {
+                self.follow(point, dir, 1.0, 0, &mut bins, &mut sides);
+            }
+        }
+        SensorGeometry { gather: Gather::from_raw(bins, sides, per_point * points.len()), points, sun_points, normal }
+    }
+
+    /// The light for a sky (and its sun). `warm` is an earlier solution of the
+    /// same model to start the iterations from.
+    pub fn solve(&self, sky: &Sky, warm: Option<&Lighting>) -> Lighting {
+        let mut bin_radiance = Vec::with_capacity(2 * self.bins.len());
+        self.bins.integrate_sphere_into(sky, &mut bin_radiance);
+        let patches = &self.scene.patches.patches;
+        let sky_irradiance = |g: &Gather| PI * g.bins.iter().map(|&(b, w)| f64::from(w) * bin_radiance[b as usize]).sum::<f64>();
+        // Direct light on every patch side.
+        let sun = sky.sun.filter(|s| s.direction.z > 0.0);
+        let direct: Vec<Channels> = par_map(patches.len() * 2, |side| {
+            let gather = &self.side_gathers[side];
+            let patch = &patches[side / 2];
+            if !matches!(self.surfaces[patch.material as usize], Surface::Diffuse(_)) {
+                return Channels::default();
+            }
+            let normal = patch.normal.as_dvec3() * if side % 2 == 1 { -1.0 } else { 1.0 };
+            let mut channels = Channels { sky: sky_irradiance(gather), ..Default::default() };
+            if let Some(sun) = sun {
+                let cos = normal.dot(sun.direction);
+                if cos > 0.0 {
+                    let triangles = self.patch_triangles(side / 2);
+                    let mut rng = Rng::new(3, side as u64);
+                    let n = self.settings.sun_samples_per_patch;
+                    let lit: f64 = (0..n)
+                        .map(|_| self.sun_transmittance(sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET, sun.direction))
+                        .sum();
+                    channels.sun = sun.normal_irradiance() * cos * lit / n as f64;
+                }
+            }
+            channels
+        });
+        let reflectance: Vec<[f64; 3]> = (0..patches.len() * 2)
+            .map(|side| match self.surfaces[patches[side / 2].material as usize] {
+                Surface::Diffuse(rho) => rho,
+                _ => [0.0; 3],
+            })
+            .collect();
+        // Jacobi: E_ind(i) = Σ_j w_ij ρ_j (E_direct(j) + E_ind(j)).
+        let mut indirect: Vec<[f64; 3]> = match warm {
+            Some(w) if w.sides.len() == direct.len() => w.sides.iter().map(|c| c.indirect).collect(),
+            _ => vec![[0.0; 3]; direct.len()],
+        };
+        let mean_direct = direct.iter().map(|c| c.sun + c.sky).sum::<f64>() / direct.len().max(1) as f64;
+        let threshold = self.settings.tolerance * mean_direct.max(1e-12);
+        let mut iterations = 0;
+        while iterations < self.settings.max_iterations {
+            iterations += 1;
+            let leaving: Vec<[f64; 3]> = (0..direct.len())
+                .map(|j| {
+                    let e = direct[j].sun + direct[j].sky;
+                    [0, 1, 2].map(|c| reflectance[j][c] * (e + indirect[j][c]))
+                })
+                .collect();
+            let next: Vec<[f64; 3]> = par_map(direct.len(), |i| {
+                let mut sum = [0.0; 3];
+                for &(j, w) in &self.side_gathers[i].sides {
+                    for c in 0..3 {
+                        sum[c] += f64::from(w) * leaving[j as usize][c];
+                    }
+                }
+                sum
+            });
+            let change = next
+                .iter()
+                .zip(&indirect)
+                .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0, f64::max))
+                .fold(0.0, f64::max);
+            indirect = next;
+            if change <= threshold {
+                break;
+            }
+        }
+        let sides: Vec<Channels> = direct.iter().zip(&indirect).map(|(d, i)| Channels { indirect: *i, ..*d }).collect();
+        let leaving: Vec<[f64; 3]> = (0..sides.len())
+            .map(|j| {
+                let e = sides[j].sun + sides[j].sky;
+                [0, 1, 2].map(|c| reflectance[j][c] * (e + sides[j].indirect[c]))
+            })
+            .collect();
+        let sensors = self
+            .scene
+            .sensors
+            .iter()
+            .zip(&self.sensors)
+            .map(|(sensor, geometry)| {
+                let direct_sun = match sun {
+                    Some(sun) if geometry.normal.dot(sun.direction) > 0.0 => {
+                        let cos = geometry.normal.dot(sun.direction);
+                        let lit: f64 = geometry.sun_points.iter().map(|&p| self.sun_transmittance(p, sun.direction)).sum();
+                        sun.normal_irradiance() * cos * lit / geometry.sun_points.len() as f64
+                    }
+                    _ => 0.0,
+                };
+                let direct_sky = sky_irradiance(&geometry.gather);
+                let mut rgb = [0.0; 3];
+                for &(j, w) in &geometry.gather.sides {
+                    for c in 0..3 {
+                        rgb[c] += f64::from(w) * leaving[j as usize][c];
+                    }
+                }
+                let indirect = Channels { indirect: rgb, ..Default::default() }.indirect_luminous();
+                let lux = |e: f64| e * LUMINOUS_EFFICACY;
+                SensorReading {
+                    name: sensor.name.clone(),
+                    total: lux(direct_sun + direct_sky + indirect),
+                    direct_sun: lux(direct_sun),
+                    direct_sky: lux(direct_sky),
+                    indirect: lux(indirect),
+                }
+            })
+            .collect();
+        Lighting { sides, sensors, iterations }
+    }
+
+    /// How many sensor points gather light (for reports).
+    pub fn sensor_points(&self) -> usize {
+        self.sensors.iter().map(|s| s.points.len()).sum()
+    }
+}
+
+/// A uniformly distributed point on triangles given with cumulative areas.
+fn sample_area(triangles: &[([DVec3; 3], f64)], rng: &mut Rng) -> DVec3 {
+    let total = triangles.last().map_or(0.0, |t| t.1);
+    let pick = rng.next_f64() * total;
+    let index = triangles.partition_point(|t| t.1 < pick).min(triangles.len() - 1);
+    point_on_triangle(&triangles[index].0, rng.next_f64(), rng.next_f64())
+}
