@@ -51,6 +51,8 @@ pub struct LightSettings {
     /// Stop when no patch's indirect irradiance changes by more than this
     /// fraction of the mean irradiance.
     pub tolerance: f64,
+    /// Worker threads; `None` for all cores. Results do not depend on it.
+    pub threads: Option<usize>,
 }
 
 impl Default for LightSettings {
@@ -63,6 +65,7 @@ impl Default for LightSettings {
             sky_subdivision: 4,
             max_iterations: 200,
             tolerance: 1e-4,
+            threads: None,
         }
     }
 }
@@ -107,8 +110,17 @@ pub struct Gather {
     pub sides: Vec<(u32, f32)>,
 }
 
+/// A ray that reached a diffuse patch side.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SideHit {
+    side: u32,
+    weight: f64,
+    point: DVec3,
+}
+
 impl Gather {
-    fn from_raw(mut bins: Vec<(u32, f64)>, mut sides: Vec<(u32, f64)>, rays: usize) -> Self {
+    fn from_raw(mut bins: Vec<(u32, f64)>, sides: &[SideHit], rays: usize) -> Self {
+        let mut sides: Vec<(u32, f64)> = sides.iter().map(|h| (h.side, h.weight)).collect();
         let merge = |v: &mut Vec<(u32, f64)>| -> Vec<(u32, f32)> {
             v.sort_by_key(|e| e.0);
             let mut out: Vec<(u32, f32)> = Vec::new();
@@ -157,6 +169,10 @@ struct SensorGeometry {
     sun_points: Vec<DVec3>,
     normal: DVec3,
     gather: Gather,
+    /// Where the sensor's rays meet patches, with their shares: the sun's
+    /// first bounce is evaluated at these points, not averaged over patches
+    /// (a sun patch right beside a sensor is what patch averages get wrong).
+    hits: Vec<(u32, f32, [f32; 3])>,
 }
 
 /// Irradiance (W/m²) on a patch side or sensor, by channel.
@@ -197,10 +213,11 @@ pub struct Lighting {
     pub iterations: usize,
 }
 
-/// Maps `f` over `0..count` on all cores; the result does not depend on how
-/// the work is split.
-fn par_map<T: Send>(count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(count.max(1));
+/// Maps `f` over `0..count` on `threads` threads (all cores when `None`);
+/// the result does not depend on how the work is split.
+fn par_map<T: Send>(threads: Option<usize>, count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let available = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = threads.unwrap_or(available).max(1).min(count.max(1));
     let chunk = count.div_ceil(threads).max(1);
     let f = &f;
     std::thread::scope(|scope| {
@@ -236,9 +253,9 @@ impl LightModel {
             sensors: Vec::new(),
         };
         let patches = &model.scene.patches.patches;
-        model.side_gathers = par_map(patches.len() * 2, |side| model.gather_patch_side(side));
+        model.side_gathers = par_map(model.settings.threads, patches.len() * 2, |side| model.gather_patch_side(side));
         let sensors = model.scene.sensors.clone();
-        model.sensors = par_map(sensors.len(), |i| model.sensor_geometry(i, &sensors[i]));
+        model.sensors = par_map(model.settings.threads, sensors.len(), |i| model.sensor_geometry(i, &sensors[i]));
         Ok(model)
     }
 
@@ -251,7 +268,7 @@ impl LightModel {
     }
 
     /// Follows a ray through glass, adding what it reaches to `bins`/`sides`.
-    fn follow(&self, origin: DVec3, dir: DVec3, weight: f64, depth: u32, bins: &mut Vec<(u32, f64)>, sides: &mut Vec<(u32, f64)>) {
+    fn follow(&self, origin: DVec3, dir: DVec3, weight: f64, depth: u32, bins: &mut Vec<(u32, f64)>, sides: &mut Vec<SideHit>) {
         match self.tracer.closest(origin, dir, 1e-6) {
             None => bins.push((self.bins.sphere_bin(dir) as u32, weight)),
             Some(hit) => {
@@ -259,7 +276,7 @@ impl LightModel {
                 let cos = dir.dot(normal);
                 let point = origin + dir * hit.distance;
                 match self.surface_of_patch(hit.patch) {
-                    Surface::Diffuse(_) => sides.push((side_of(hit.patch, cos > 0.0), weight)),
+                    Surface::Diffuse(_) => sides.push(SideHit { side: side_of(hit.patch, cos > 0.0), weight, point }),
                     Surface::PassThrough if depth < MAX_GLASS_DEPTH => {
                         self.follow(point + dir * SURFACE_OFFSET, dir, weight, depth + 1, bins, sides)
                     }
@@ -310,7 +327,7 @@ impl LightModel {
             let point = sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET;
             self.follow(point, dir, 1.0, 0, &mut bins, &mut sides);
         }
-        Gather::from_raw(bins, sides, self.settings.rays_per_patch)
+        Gather::from_raw(bins, &sides, self.settings.rays_per_patch)
     }
 
     /// A patch's render triangles with their cumulative areas.
@@ -358,7 +375,9 @@ impl LightModel {
                 self.follow(point, dir, 1.0, 0, &mut bins, &mut sides);
             }
         }
-        SensorGeometry { gather: Gather::from_raw(bins, sides, per_point * points.len()), points, sun_points, normal }
+        let rays = per_point * points.len();
+        let hits = sides.iter().map(|h| (h.side, (h.weight / rays as f64) as f32, h.point.as_vec3().to_array())).collect();
+        SensorGeometry { gather: Gather::from_raw(bins, &sides, rays), points, sun_points, normal, hits }
     }
 
     /// The light for a sky (and its sun). `warm` is an earlier solution of the
@@ -370,7 +389,7 @@ impl LightModel {
         let sky_irradiance = |g: &Gather| PI * g.bins.iter().map(|&(b, w)| f64::from(w) * bin_radiance[b as usize]).sum::<f64>();
         // Direct light on every patch side.
         let sun = sky.sun.filter(|s| s.direction.z > 0.0);
-        let direct: Vec<Channels> = par_map(patches.len() * 2, |side| {
+        let direct: Vec<Channels> = par_map(self.settings.threads, patches.len() * 2, |side| {
             let gather = &self.side_gathers[side];
             let patch = &patches[side / 2];
             if !matches!(self.surfaces[patch.material as usize], Surface::Diffuse(_)) {
@@ -414,7 +433,7 @@ impl LightModel {
                     [0, 1, 2].map(|c| reflectance[j][c] * (e + indirect[j][c]))
                 })
                 .collect();
-            let next: Vec<[f64; 3]> = par_map(direct.len(), |i| {
+            let next: Vec<[f64; 3]> = par_map(self.settings.threads, direct.len(), |i| {
                 let mut sum = [0.0; 3];
                 for &(j, w) in &self.side_gathers[i].sides {
                     for c in 0..3 {
@@ -434,11 +453,10 @@ impl LightModel {
             }
         }
         let sides: Vec<Channels> = direct.iter().zip(&indirect).map(|(d, i)| Channels { indirect: *i, ..*d }).collect();
-        let leaving: Vec<[f64; 3]> = (0..sides.len())
-            .map(|j| {
-                let e = sides[j].sun + sides[j].sky;
-                [0, 1, 2].map(|c| reflectance[j][c] * (e + sides[j].indirect[c]))
-            })
+        // What leaves each side but its first bounce of sun, which sensors
+        // evaluate where their rays land.
+        let without_sun: Vec<[f64; 3]> = (0..sides.len())
+            .map(|j| [0, 1, 2].map(|c| reflectance[j][c] * (sides[j].sky + sides[j].indirect[c])))
             .collect();
         let sensors = self
             .scene
@@ -458,7 +476,21 @@ impl LightModel {
                 let mut rgb = [0.0; 3];
                 for &(j, w) in &geometry.gather.sides {
                     for c in 0..3 {
-                        rgb[c] += f64::from(w) * leaving[j as usize][c];
+                        rgb[c] += f64::from(w) * without_sun[j as usize][c];
+                    }
+                }
+                if let Some(sun) = sun {
+                    for &(j, w, point) in &geometry.hits {
+                        let side_normal = self.patch_normal(j / 2) * if j % 2 == 1 { -1.0 } else { 1.0 };
+                        let cos = side_normal.dot(sun.direction);
+                        if cos <= 0.0 {
+                            continue;
+                        }
+                        let origin = glam::Vec3::from_array(point).as_dvec3() + side_normal * SURFACE_OFFSET;
+                        let e = sun.normal_irradiance() * cos * self.sun_transmittance(origin, sun.direction);
+                        for c in 0..3 {
+                            rgb[c] += f64::from(w) * reflectance[j as usize][c] * e;
+                        }
                     }
                 }
                 let indirect = Channels { indirect: rgb, ..Default::default() }.indirect_luminous();

@@ -1,0 +1,144 @@
+//! The light engine against Radiance (the validation room, its references
+//! copied from ../shared/validation into tests/fixtures/sideroom), and its
+//! physical and numerical promises.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use heliodon::light::{LightModel, LightSettings};
+use heliodon::scene::{PanelNames, Scene, load_scene};
+use heliodon::sky::{Sky, SkySpec, integrate_hemisphere};
+use heliodon::sun::solar_position;
+use heliodon::time::{Date, LocalDateTime, TimeOfDay};
+
+fn load(path: &Path) -> Arc<Scene> {
+    Arc::new(load_scene(path, &PanelNames::new()).unwrap().scene)
+}
+
+fn sideroom() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/sideroom/scene.toml")
+}
+
+fn sky_at(scene: &Scene, spec: &SkySpec, date: &str, time: &str) -> Sky {
+    let when = LocalDateTime { date: Date::parse(date).unwrap(), time: TimeOfDay::parse(time).unwrap() };
+    let sun = solar_position(&scene.site, &when);
+    Sky::new(spec, sun.altitude, sun.azimuth, scene.site.ground_reflectance, when.date.day_of_year()).unwrap()
+}
+
+#[test]
+fn validation_room_agrees_with_radiance() {
+    let references: HashMap<(String, String, String, String), f64> = include_str!("fixtures/sideroom/radiance.csv")
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            ((f[1].into(), f[2].into(), f[3].into(), f[4].into()), f[5].parse().unwrap())
+        })
+        .collect();
+    let scene = load(&sideroom());
+    let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
+    let cases = [("2026-03-21", "12:00", "clear"), ("2026-06-21", "15:00", "overcast"), ("2026-12-21", "09:00", "intermediate"), ("2026-03-21", "12:00", "uniform")];
+    let mut errors = Vec::new();
+    for (date, time, sky_name) in cases {
+        let spec = SkySpec::parse(sky_name, &Default::default()).unwrap();
+        let lighting = model.solve(&sky_at(&scene, &spec, date, time), None);
+        for reading in &lighting.sensors {
+            let reference = references[&(date.to_string(), time.to_string(), sky_name.to_string(), reading.name.clone())];
+            let error = if reference >= 50.0 { (reading.total / reference - 1.0).abs() } else { (reading.total - reference).abs() / 250.0 };
+            println!("{date} {time} {sky_name:12} {:15} ref {reference:9.1} got {:9.1} ({:+.1}%)", reading.name, reading.total, 100.0 * (reading.total / reference - 1.0));
+            errors.push(error);
+        }
+    }
+    errors.sort_by(f64::total_cmp);
+    let median = errors[errors.len() / 2];
+    let p90 = errors[errors.len() * 9 / 10];
+    println!("median {:.2}% p90 {:.2}% max {:.2}%", 100.0 * median, 100.0 * p90, 100.0 * errors.last().unwrap());
+    assert!(median <= 0.05 && p90 <= 0.10, "median {median} p90 {p90}");
+}
+
+fn quick() -> LightSettings {
+    LightSettings { rays_per_patch: 64, rays_per_sensor: 512, sun_samples_per_patch: 4, area_sensor_sun_grid: 4, ..Default::default() }
+}
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let scene = load(&heliodon::bundled_scene("test_room"));
+    let sky = sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-03-21", "10:00");
+    let one = LightModel::precompute(scene.clone(), LightSettings { threads: Some(1), ..quick() }).unwrap().solve(&sky, None);
+    let three = LightModel::precompute(scene.clone(), LightSettings { threads: Some(3), ..quick() }).unwrap().solve(&sky, None);
+    assert_eq!(one, three);
+}
+
+/// A sensor above the roof sees the whole sky and the sun: its reading is
+/// the sky's horizontal irradiance plus the sun's, with nothing in the way.
+#[test]
+fn a_sensor_outside_reads_the_open_sky() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_outside");
+    std::fs::create_dir_all(&dir).unwrap();
+    let room = std::fs::read_to_string(sideroom()).unwrap();
+    let scene_text = room.replace("[[sensors]]\nname = \"s00\"", "[[sensors]]\nname = \"roof\"\nposition = [2.0, 3.0, 4.0]\nnormal = [0.0, 0.0, 1.0]\n\n[[sensors]]\nname = \"s00\"");
+    std::fs::write(dir.join("scene.toml"), scene_text).unwrap();
+    for f in ["model.obj", "model.mtl"] {
+        std::fs::copy(sideroom().with_file_name(f), dir.join(f)).unwrap();
+    }
+    let scene = load(&dir.join("scene.toml"));
+    let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
+    let sky = sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-06-21", "11:00");
+    let roof = &model.solve(&sky, None).sensors[0];
+    assert_eq!(roof.name, "roof");
+    let sun = sky.sun.unwrap();
+    let (_, diffuse) = integrate_hemisphere(|d| sky.radiance(d), (400, 800));
+    assert!((roof.direct_sun / 179.0 / (sun.normal_irradiance() * sun.direction.z) - 1.0).abs() < 1e-9);
+    assert!((roof.direct_sky / 179.0 / diffuse - 1.0).abs() < 0.01, "{} vs {}", roof.direct_sky / 179.0, diffuse);
+    // Nothing above the roof reflects light down on it.
+    assert_eq!(roof.indirect, 0.0);
+}
+
+#[test]
+fn a_room_without_windows_is_dark_and_the_night_has_no_sun() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_closed");
+    std::fs::create_dir_all(&dir).unwrap();
+    let room = std::fs::read_to_string(sideroom()).unwrap();
+    std::fs::write(dir.join("scene.toml"), room).unwrap();
+    let obj = std::fs::read_to_string(sideroom().with_file_name("model.obj")).unwrap();
+    std::fs::write(dir.join("model.obj"), obj.replace("usemtl glass", "usemtl wall")).unwrap();
+    std::fs::copy(sideroom().with_file_name("model.mtl"), dir.join("model.mtl")).unwrap();
+    let scene = load(&dir.join("scene.toml"));
+    assert!(scene.windows.is_empty());
+    let model = LightModel::precompute(scene.clone(), quick()).unwrap();
+    let lighting = model.solve(&sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-06-21", "12:00"), None);
+    assert!(lighting.sensors.iter().all(|r| r.total == 0.0), "{:?}", lighting.sensors[0]);
+
+    let scene = load(&sideroom());
+    let model = LightModel::precompute(scene.clone(), quick()).unwrap();
+    let night = model.solve(&sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-06-21", "23:00"), None);
+    assert!(night.sensors.iter().all(|r| r.direct_sun == 0.0 && r.total == 0.0));
+}
+
+#[test]
+fn warm_starts_converge_to_the_same_light() {
+    let scene = load(&sideroom());
+    let model = LightModel::precompute(scene.clone(), quick()).unwrap();
+    let first = model.solve(&sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "09:00"), None);
+    let sky = sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "10:00");
+    let cold = model.solve(&sky, None);
+    let warm = model.solve(&sky, Some(&first));
+    assert!(warm.iterations < cold.iterations, "{} vs {}", warm.iterations, cold.iterations);
+    for (a, b) in cold.sensors.iter().zip(&warm.sensors) {
+        assert!((a.total / b.total - 1.0).abs() < 1e-3, "{a:?} {b:?}");
+    }
+}
+
+#[test]
+fn settings_that_cannot_work_are_refused() {
+    let scene = load(&sideroom());
+    for bad in [
+        LightSettings { rays_per_patch: 0, ..Default::default() },
+        LightSettings { sky_subdivision: 0, ..Default::default() },
+        LightSettings { tolerance: -1.0, ..Default::default() },
+    ] {
+        let error = LightModel::precompute(scene.clone(), bad).err().expect("refused");
+        assert!(error.starts_with("lighting setting") || error.contains("MF:") || error.contains("tolerance"), "{error}");
+    }
+}
