@@ -176,3 +176,54 @@ fn the_sun_and_sky_follow_the_clock_once_per_change() {
     assert_eq!(messages(&mut app), 1);
     assert!(app.world().resource::<SunSky>().sky.sun.is_none());
 }
+
+#[test]
+fn relights_run_as_tasks_and_the_last_change_wins() {
+    use heliodon::ecs::{LightEngine, LightingSettings, LightingState, LightingUpdated, SolarTime, SunSky};
+    use heliodon::light::LightSettings;
+    use heliodon::time::{LocalDateTime, TimeOfDay};
+
+    let mut app = headless_app();
+    let settings = LightSettings { rays_per_patch: 64, rays_per_sensor: 512, sun_samples_per_patch: 4, area_sensor_sun_grid: 4, ..Default::default() };
+    app.insert_resource(LightingSettings(settings));
+    open(&mut app, heliodon::bundled_scene("test_room")).unwrap();
+    let mut seen: Vec<u64> = Vec::new();
+    let mut run_until_settled = |app: &mut App, seen: &mut Vec<u64>| {
+        let deadline = Instant::now() + Duration::from_secs(120);
+        loop {
+            app.update();
+            seen.extend(app.world_mut().resource_mut::<Messages<LightingUpdated>>().drain().map(|m| m.generation));
+            let engine = app.world().resource::<LightEngine>();
+            let state = app.world().resource::<LightingState>();
+            if engine.model.is_some() && state.converged && state.generation == engine.generation() {
+                return;
+            }
+            assert!(Instant::now() < deadline, "lighting did not settle");
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    };
+    run_until_settled(&mut app, &mut seen);
+    let first = app.world().resource::<LightingState>().generation;
+    // Three changes of time in quick succession: one frame each.
+    let date = app.world().resource::<SolarTime>().0.date;
+    for hours in [9.0, 11.0, 15.5] {
+        app.world_mut().resource_mut::<SolarTime>().0 = LocalDateTime { date, time: TimeOfDay::from_hours(hours).unwrap() };
+        app.update();
+        seen.extend(app.world_mut().resource_mut::<Messages<LightingUpdated>>().drain().map(|m| m.generation));
+    }
+    run_until_settled(&mut app, &mut seen);
+    // Results arrived in order: never an older relight after a newer one.
+    assert!(seen.windows(2).all(|w| w[0] <= w[1]), "{seen:?}");
+    let world = app.world();
+    let state = world.resource::<LightingState>();
+    assert!(state.generation > first);
+    // The final light is that of the last time, as a fresh solve gives it.
+    let model = world.resource::<LightEngine>().model.clone().unwrap();
+    let sky = &world.resource::<SunSky>().sky;
+    let fresh = model.solve(sky, None);
+    for (a, b) in state.lighting.as_ref().unwrap().sensors.iter().zip(&fresh.sensors) {
+        assert_eq!(a.name, b.name);
+        assert!((a.total - b.total).abs() <= 1e-3 * b.total.max(1.0), "{a:?} vs {b:?}");
+        assert_eq!(a.direct_sun, b.direct_sun);
+    }
+}

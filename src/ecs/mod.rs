@@ -4,6 +4,7 @@
 //! viewer. Drawing lives in [`crate::render`], windows and input in
 //! [`crate::viewer`].
 
+mod lighting;
 mod scene_asset;
 mod scene_plugin;
 mod sun_sky;
@@ -16,6 +17,7 @@ pub use scene_plugin::{
     ActiveScene, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, ScenePlugin, SceneRoot, SceneSpawned,
     SceneSurface, SceneSensor, SceneWindow, Site,
 };
+pub use lighting::{LightEngine, LightingFailed, LightingPlugin, LightingSettings, LightingState, LightingUpdated};
 pub use sun_sky::{LightChanged, SkyChoice, SkyRejected, SkySubdivision, SolarTime, SunSky, SunSkyPlugin};
 
 /// The simulation plugins, in dependency order.
@@ -23,7 +25,7 @@ pub struct HeliodonPlugins;
 
 impl PluginGroup for HeliodonPlugins {
     fn build(self) -> PluginGroupBuilder {
-        PluginGroupBuilder::start::<Self>().add(ScenePlugin).add(SunSkyPlugin)
+        PluginGroupBuilder::start::<Self>().add(ScenePlugin).add(SunSkyPlugin).add(LightingPlugin)
     }
 }
 
@@ -36,4 +38,6 @@ pub enum HeliodonSystems {
     SpawnScene,
     /// Recompute the sun and sky when the site, time or sky changed.
     UpdateSunSky,
+    /// Precompute light transport for a new scene; start, and apply, relights.
+    Lighting,
 }

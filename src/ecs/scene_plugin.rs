@@ -26,7 +26,13 @@ impl Plugin for ScenePlugin {
             .add_message::<SceneLoadFailed>()
             .configure_sets(
                 Update,
-                (HeliodonSystems::LoadScene, HeliodonSystems::SpawnScene, HeliodonSystems::UpdateSunSky).chain(),
+                (
+                    HeliodonSystems::LoadScene,
+                    HeliodonSystems::SpawnScene,
+                    HeliodonSystems::UpdateSunSky,
+                    HeliodonSystems::Lighting,
+                )
+                    .chain(),
             )
             .add_systems(Update, request_scene.in_set(HeliodonSystems::LoadScene))
             .add_systems(Update, (spawn_loaded_scene, report_failed_load).in_set(HeliodonSystems::SpawnScene));

@@ -48,8 +48,8 @@ pub struct LightSettings {
     pub sky_subdivision: u32,
     /// Jacobi iterations at most.
     pub max_iterations: usize,
-    /// Stop when no patch's indirect irradiance changes by more than this
-    /// fraction of the mean irradiance.
+    /// Stop when no patch side's indirect irradiance changes by more than
+    /// this fraction of its own irradiance in an iteration.
     pub tolerance: f64,
     /// Worker threads; `None` for all cores. Results do not depend on it.
     pub threads: Option<usize>,
@@ -380,14 +380,22 @@ impl LightModel {
         SensorGeometry { gather: Gather::from_raw(bins, &sides, rays), points, sun_points, normal, hits }
     }
 
-    /// The light for a sky (and its sun). `warm` is an earlier solution of the
-    /// same model to start the iterations from.
+    /// The light for a sky (and its sun), iterated to convergence. `warm` is
+    /// an earlier solution of the same model to start from.
     pub fn solve(&self, sky: &Sky, warm: Option<&Lighting>) -> Lighting {
+        let mut relight = self.relight(sky, warm);
+        while !relight.step() {}
+        relight.lighting()
+    }
+
+    /// Starts relighting for a sky: the direct light (sun and sky on every
+    /// patch side and sensor) is computed now; [`Relight::step`] then iterates
+    /// the interreflection, and [`Relight::lighting`] reads the state at any time.
+    pub fn relight(&self, sky: &Sky, warm: Option<&Lighting>) -> Relight<'_> {
         let mut bin_radiance = Vec::with_capacity(2 * self.bins.len());
         self.bins.integrate_sphere_into(sky, &mut bin_radiance);
         let patches = &self.scene.patches.patches;
         let sky_irradiance = |g: &Gather| PI * g.bins.iter().map(|&(b, w)| f64::from(w) * bin_radiance[b as usize]).sum::<f64>();
-        // Direct light on every patch side.
         let sun = sky.sun.filter(|s| s.direction.z > 0.0);
         let direct: Vec<Channels> = par_map(self.settings.threads, patches.len() * 2, |side| {
             let gather = &self.side_gathers[side];
@@ -417,99 +425,157 @@ impl LightModel {
                 _ => [0.0; 3],
             })
             .collect();
-        // Jacobi: E_ind(i) = Σ_j w_ij ρ_j (E_direct(j) + E_ind(j)).
-        let mut indirect: Vec<[f64; 3]> = match warm {
+        // Each sensor's direct light and the first bounce of sun where its rays land.
+        let sensors: Vec<SensorDirect> = par_map(self.settings.threads, self.sensors.len(), |i| {
+            let geometry = &self.sensors[i];
+            let mut out = SensorDirect { sky: sky_irradiance(&geometry.gather), ..Default::default() };
+            let Some(sun) = sun else { return out };
+            let cos = geometry.normal.dot(sun.direction);
+            if cos > 0.0 {
+                let lit: f64 = geometry.sun_points.iter().map(|&p| self.sun_transmittance(p, sun.direction)).sum();
+                out.sun = sun.normal_irradiance() * cos * lit / geometry.sun_points.len() as f64;
+            }
+            for &(j, w, point) in &geometry.hits {
+                let side_normal = self.patch_normal(j / 2) * if j % 2 == 1 { -1.0 } else { 1.0 };
+                let cos = side_normal.dot(sun.direction);
+                if cos > 0.0 {
+                    let origin = glam::Vec3::from_array(point).as_dvec3() + side_normal * SURFACE_OFFSET;
+                    let e = sun.normal_irradiance() * cos * self.sun_transmittance(origin, sun.direction);
+                    for c in 0..3 {
+                        out.sun_bounce[c] += f64::from(w) * reflectance[j as usize][c] * e;
+                    }
+                }
+            }
+            out
+        });
+        let indirect = match warm {
             Some(w) if w.sides.len() == direct.len() => w.sides.iter().map(|c| c.indirect).collect(),
             _ => vec![[0.0; 3]; direct.len()],
         };
         let mean_direct = direct.iter().map(|c| c.sun + c.sky).sum::<f64>() / direct.len().max(1) as f64;
-        let threshold = self.settings.tolerance * mean_direct.max(1e-12);
-        let mut iterations = 0;
-        while iterations < self.settings.max_iterations {
-            iterations += 1;
-            let leaving: Vec<[f64; 3]> = (0..direct.len())
-                .map(|j| {
-                    let e = direct[j].sun + direct[j].sky;
-                    [0, 1, 2].map(|c| reflectance[j][c] * (e + indirect[j][c]))
-                })
-                .collect();
-            let next: Vec<[f64; 3]> = par_map(self.settings.threads, direct.len(), |i| {
-                let mut sum = [0.0; 3];
-                for &(j, w) in &self.side_gathers[i].sides {
-                    for c in 0..3 {
-                        sum[c] += f64::from(w) * leaving[j as usize][c];
-                    }
-                }
-                sum
-            });
-            let change = next
-                .iter()
-                .zip(&indirect)
-                .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0, f64::max))
-                .fold(0.0, f64::max);
-            indirect = next;
-            if change <= threshold {
-                break;
-            }
+        Relight {
+            model: self,
+            floor: 1e-3 * mean_direct.max(1e-12),
+            direct,
+            reflectance,
+            indirect,
+            sensors,
+            iterations: 0,
+            converged: false,
         }
-        let sides: Vec<Channels> = direct.iter().zip(&indirect).map(|(d, i)| Channels { indirect: *i, ..*d }).collect();
-        // What leaves each side but its first bounce of sun, which sensors
-        // evaluate where their rays land.
-        let without_sun: Vec<[f64; 3]> = (0..sides.len())
-            .map(|j| [0, 1, 2].map(|c| reflectance[j][c] * (sides[j].sky + sides[j].indirect[c])))
-            .collect();
-        let sensors = self
+    }
+
+    /// How many sensor points gather light (for reports).
+    pub fn sensor_points(&self) -> usize {
+        self.sensors.iter().map(|s| s.points.len()).sum()
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct SensorDirect {
+    sun: f64,
+    sky: f64,
+    /// RGB irradiance from the sun's first reflection off patches.
+    sun_bounce: [f64; 3],
+}
+
+/// A relight in progress: direct light computed, interreflection iterating.
+pub struct Relight<'a> {
+    model: &'a LightModel,
+    /// Irradiance below which a side counts as dark (for relative convergence).
+    floor: f64,
+    direct: Vec<Channels>,
+    reflectance: Vec<[f64; 3]>,
+    indirect: Vec<[f64; 3]>,
+    sensors: Vec<SensorDirect>,
+    iterations: usize,
+    converged: bool,
+}
+
+impl Relight<'_> {
+    /// One Jacobi iteration, E_ind(i) = Σ_j w_ij ρ_j (E_direct(j) + E_ind(j)).
+    /// Returns whether the solution has converged (or the iteration budget is spent).
+    pub fn step(&mut self) -> bool {
+        if self.converged {
+            return true;
+        }
+        let model = self.model;
+        let leaving = self.leaving(true);
+        let next: Vec<[f64; 3]> = par_map(model.settings.threads, self.direct.len(), |i| {
+            let mut sum = [0.0; 3];
+            for &(j, w) in &model.side_gathers[i].sides {
+                for c in 0..3 {
+                    sum[c] += f64::from(w) * leaving[j as usize][c];
+                }
+            }
+            sum
+        });
+        // The largest change relative to each side's own irradiance (dark
+        // corners converge as well as sunlit floors).
+        let change = next
+            .iter()
+            .zip(&self.indirect)
+            .zip(&self.direct)
+            .map(|((a, b), d)| {
+                let level = (d.sun + d.sky + a.iter().copied().fold(0.0, f64::max)).max(self.floor);
+                (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0, f64::max) / level
+            })
+            .fold(0.0, f64::max);
+        self.indirect = next;
+        self.iterations += 1;
+        self.converged = change <= model.settings.tolerance || self.iterations >= model.settings.max_iterations;
+        self.converged
+    }
+
+    pub fn iterations(&self) -> usize {
+        self.iterations
+    }
+
+    pub fn is_converged(&self) -> bool {
+        self.converged
+    }
+
+    /// Radiant exitance of each side (RGB), with or without its direct sun.
+    fn leaving(&self, with_sun: bool) -> Vec<[f64; 3]> {
+        (0..self.direct.len())
+            .map(|j| {
+                let e = if with_sun { self.direct[j].sun } else { 0.0 } + self.direct[j].sky;
+                [0, 1, 2].map(|c| self.reflectance[j][c] * (e + self.indirect[j][c]))
+            })
+            .collect()
+    }
+
+    /// The light as it stands.
+    pub fn lighting(&self) -> Lighting {
+        let model = self.model;
+        let sides = self.direct.iter().zip(&self.indirect).map(|(d, i)| Channels { indirect: *i, ..*d }).collect();
+        // Sensors take the sun's first bounce from where their rays land.
+        let without_sun = self.leaving(false);
+        let sensors = model
             .scene
             .sensors
             .iter()
+            .zip(&model.sensors)
             .zip(&self.sensors)
-            .map(|(sensor, geometry)| {
-                let direct_sun = match sun {
-                    Some(sun) if geometry.normal.dot(sun.direction) > 0.0 => {
-                        let cos = geometry.normal.dot(sun.direction);
-                        let lit: f64 = geometry.sun_points.iter().map(|&p| self.sun_transmittance(p, sun.direction)).sum();
-                        sun.normal_irradiance() * cos * lit / geometry.sun_points.len() as f64
-                    }
-                    _ => 0.0,
-                };
-                let direct_sky = sky_irradiance(&geometry.gather);
-                let mut rgb = [0.0; 3];
+            .map(|((sensor, geometry), direct)| {
+                let mut rgb = direct.sun_bounce;
                 for &(j, w) in &geometry.gather.sides {
                     for c in 0..3 {
                         rgb[c] += f64::from(w) * without_sun[j as usize][c];
-                    }
-                }
-                if let Some(sun) = sun {
-                    for &(j, w, point) in &geometry.hits {
-                        let side_normal = self.patch_normal(j / 2) * if j % 2 == 1 { -1.0 } else { 1.0 };
-                        let cos = side_normal.dot(sun.direction);
-                        if cos <= 0.0 {
-                            continue;
-                        }
-                        let origin = glam::Vec3::from_array(point).as_dvec3() + side_normal * SURFACE_OFFSET;
-                        let e = sun.normal_irradiance() * cos * self.sun_transmittance(origin, sun.direction);
-                        for c in 0..3 {
-                            rgb[c] += f64::from(w) * reflectance[j as usize][c] * e;
-                        }
                     }
                 }
                 let indirect = Channels { indirect: rgb, ..Default::default() }.indirect_luminous();
                 let lux = |e: f64| e * LUMINOUS_EFFICACY;
                 SensorReading {
                     name: sensor.name.clone(),
-                    total: lux(direct_sun + direct_sky + indirect),
-                    direct_sun: lux(direct_sun),
-                    direct_sky: lux(direct_sky),
+                    total: lux(direct.sun + direct.sky + indirect),
+                    direct_sun: lux(direct.sun),
+                    direct_sky: lux(direct.sky),
                     indirect: lux(indirect),
                 }
             })
             .collect();
-        Lighting { sides, sensors, iterations }
-    }
-
-    /// How many sensor points gather light (for reports).
-    pub fn sensor_points(&self) -> usize {
-        self.sensors.iter().map(|s| s.points.len()).sum()
+        Lighting { sides, sensors, iterations: self.iterations }
     }
 }
 
