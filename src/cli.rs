@@ -2,6 +2,7 @@
 //! parsing with clap, one line per error, and the text of each subcommand.
 
 use std::fmt::Write as _;
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -9,7 +10,7 @@ use clap::{Parser, Subcommand};
 
 use crate::ecs::PanelRegistry;
 use crate::scene::{self, MaterialKind, Scene};
-use crate::light::{LightModel, LightSettings, Lighting};
+use crate::light::{LightSettings, Lighting, cache};
 use crate::site::Site;
 use crate::sky::{Sky, SkyInputs, SkySpec};
 use crate::sun::{self, SolarPosition};
@@ -97,6 +98,9 @@ pub struct SensorsArgs {
     pub sky: SkyArgs,
     #[arg(long, value_enum, default_value_t = Format::Table)]
     pub format: Format,
+    /// Neither read nor write the precomputation cache
+    #[arg(long)]
+    pub no_cache: bool,
 }
 
 /// The sky flags shared by the commands that light a scene.
@@ -212,6 +216,14 @@ pub fn main() -> ExitCode {
     }
 }
 
+/// A progress bar on standard error, when it is a terminal.
+fn progress_bar(fraction: f64) {
+    if std::io::stderr().is_terminal() {
+        let filled = (fraction * 40.0).round() as usize;
+        eprint!("\rprecomputing light [{}{}] {:3.0}%", "#".repeat(filled), " ".repeat(40 - filled.min(40)), 100.0 * fraction);
+    }
+}
+
 /// The `sensors` command: one precomputation, then every date × time.
 pub fn sensors(args: &SensorsArgs) -> Result<String, String> {
     let spec = args.sky.spec()?;
@@ -221,7 +233,11 @@ pub fn sensors(args: &SensorsArgs) -> Result<String, String> {
     }
     let scene = std::sync::Arc::new(loaded.scene);
     let site = scene.site;
-    let model = LightModel::precompute(scene.clone(), LightSettings::default())?;
+    let cache_dir = if args.no_cache { None } else { cache::default_dir() };
+    let (model, _) = cache::precompute_cached(scene.clone(), LightSettings::default(), cache_dir.as_deref(), &progress_bar)?;
+    if std::io::stderr().is_terminal() {
+        eprint!("\r{:60}\r", "");
+    }
     let cases: Vec<LocalDateTime> =
         args.date.iter().flat_map(|&date| args.time.iter().map(move |&time| LocalDateTime { date, time })).collect();
     let several = cases.len() > 1;

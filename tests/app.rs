@@ -179,16 +179,16 @@ fn the_sun_and_sky_follow_the_clock_once_per_change() {
 
 #[test]
 fn relights_run_as_tasks_and_the_last_change_wins() {
-    use heliodon::ecs::{LightEngine, LightingSettings, LightingState, LightingUpdated, SolarTime, SunSky};
+    use heliodon::ecs::{LightCacheDir, LightEngine, LightingSettings, LightingState, LightingUpdated, SolarTime, SunSky};
     use heliodon::light::LightSettings;
     use heliodon::time::{LocalDateTime, TimeOfDay};
 
     let mut app = headless_app();
     let settings = LightSettings { rays_per_patch: 64, rays_per_sensor: 512, sun_samples_per_patch: 4, area_sensor_sun_grid: 4, ..Default::default() };
-    app.insert_resource(LightingSettings(settings));
+    app.insert_resource(LightingSettings(settings)).insert_resource(LightCacheDir(None));
     open(&mut app, heliodon::bundled_scene("test_room")).unwrap();
     let mut seen: Vec<u64> = Vec::new();
-    let mut run_until_settled = |app: &mut App, seen: &mut Vec<u64>| {
+    let run_until_settled = |app: &mut App, seen: &mut Vec<u64>| {
         let deadline = Instant::now() + Duration::from_secs(120);
         loop {
             app.update();

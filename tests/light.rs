@@ -142,3 +142,116 @@ fn settings_that_cannot_work_are_refused() {
         assert!(error.starts_with("lighting setting") || error.contains("MF:") || error.contains("tolerance"), "{error}");
     }
 }
+
+#[test]
+fn the_cache_is_used_and_never_trusted_when_damaged() {
+    use heliodon::light::cache::{CacheOutcome, precompute_cached};
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_cache");
+    let _ = std::fs::remove_dir_all(&dir);
+    let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_cache_scene");
+    std::fs::create_dir_all(&work).unwrap();
+    for f in ["scene.toml", "model.obj", "model.mtl"] {
+        std::fs::copy(sideroom().with_file_name(f), work.join(f)).unwrap();
+    }
+    let scene = load(&work.join("scene.toml"));
+    let sky = sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-03-21", "10:00");
+    let settings = quick();
+    let (fresh, outcome) = precompute_cached(scene.clone(), settings, Some(&dir), &|_| {}).unwrap();
+    let CacheOutcome::Stored(path) = outcome else { panic!("{outcome:?}") };
+    let expected = fresh.solve(&sky, None);
+    let (cached, outcome) = precompute_cached(scene.clone(), settings, Some(&dir), &|_| {}).unwrap();
+    assert_eq!(outcome, CacheOutcome::Hit(path.clone()));
+    assert_eq!(cached.solve(&sky, None), expected);
+    // Damaged files are rebuilt: a flipped byte, a truncation, garbage.
+    let good = std::fs::read(&path).unwrap();
+    let mut flipped = good.clone();
+    let last = flipped.len() - 3;
+    flipped[last] ^= 0x40;
+    for (damage, why) in [(flipped, "checksum mismatch"), (good[..good.len() / 2].to_vec(), "truncated"), (b"hello".to_vec(), "not a heliodon light cache")] {
+        std::fs::write(&path, damage).unwrap();
+        let (model, outcome) = precompute_cached(scene.clone(), settings, Some(&dir), &|_| {}).unwrap();
+        assert_eq!(outcome, CacheOutcome::Rebuilt(path.clone(), why.to_string()));
+        assert_eq!(model.solve(&sky, None), expected);
+    }
+    // A different model is a different key; different settings too.
+    let obj = std::fs::read_to_string(work.join("model.obj")).unwrap();
+    std::fs::write(work.join("model.obj"), format!("{obj}# edited\n")).unwrap();
+    let (_, outcome) = precompute_cached(scene.clone(), settings, Some(&dir), &|_| {}).unwrap();
+    assert!(matches!(&outcome, CacheOutcome::Stored(p) if *p != path), "{outcome:?}");
+    let (_, outcome) = precompute_cached(scene.clone(), LightSettings { rays_per_patch: 65, ..settings }, Some(&dir), &|_| {}).unwrap();
+    assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");
+    let (_, outcome) = precompute_cached(scene, settings, None, &|_| {}).unwrap();
+    assert_eq!(outcome, CacheOutcome::Skipped("disabled".into()));
+}
+
+// ---- the sensors command -------------------------------------------------------------
+
+fn heliodon(args: &[&str], cache: &Path) -> (i32, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_heliodon"))
+        .args(args)
+        .env("HELIODON_CACHE_DIR", cache)
+        .output()
+        .expect("run heliodon");
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+#[test]
+fn sensors_command_prints_the_contract_csv_and_shares_one_precomputation() {
+    let cache = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sensors_cli_cache");
+    let _ = std::fs::remove_dir_all(&cache);
+    let scene_path = sideroom();
+    let scene = scene_path.to_str().unwrap();
+    let args = ["sensors", scene, "--date", "2026-03-21", "--time", "12:00", "--sky", "overcast", "--format", "csv"];
+    let (code, first, err) = heliodon(&args, &cache);
+    assert_eq!(code, 0, "{err}");
+    let lines: Vec<&str> = first.lines().collect();
+    assert_eq!(lines[0], "name,illuminance_lux,direct_sun_lux,direct_sky_lux,indirect_lux");
+    assert_eq!(lines.len(), 1 + 19);
+    for line in &lines[1..] {
+        let f: Vec<&str> = line.split(',').collect();
+        let v: Vec<f64> = f[1..].iter().map(|x| x.parse().unwrap()).collect();
+        assert!(v.iter().all(|x| x.is_finite() && *x >= 0.0));
+        assert!((v[0] - v[1] - v[2] - v[3]).abs() <= 0.2, "parts add up: {line}");
+        assert_eq!(v[1], 0.0, "no sun under an overcast sky");
+    }
+    // The same from the library.
+    let model = LightModel::precompute(load(&scene_path), LightSettings::default()).unwrap();
+    let expected = model.solve(&sky_at(&model.scene, &SkySpec::Overcast, "2026-03-21", "12:00"), None);
+    assert_eq!(lines[1], format!("s00,{:.1},{:.1},{:.1},{:.1}", expected.sensors[0].total, expected.sensors[0].direct_sun, expected.sensors[0].direct_sky, expected.sensors[0].indirect));
+    // A second run reads the cache and says the same.
+    let (_, second, _) = heliodon(&args, &cache);
+    assert_eq!(first, second);
+    assert!(std::fs::read_dir(&cache).unwrap().count() == 1);
+    // Several times and dates in one call.
+    let (code, many, _) = heliodon(&["sensors", scene, "--date", "2026-03-21,2026-06-21", "--time", "09:00,12:00", "--sky", "clear", "--format", "csv"], &cache);
+    assert_eq!(code, 0);
+    let rows: Vec<&str> = many.lines().collect();
+    assert_eq!(rows[0], "date,time,name,illuminance_lux,direct_sun_lux,direct_sky_lux,indirect_lux");
+    assert_eq!(rows.len(), 1 + 4 * 19);
+    assert!(rows[1].starts_with("2026-03-21,09:00:00,s00,") && rows[rows.len() - 1].starts_with("2026-06-21,12:00:00,ceiling_centre,"));
+}
+
+#[test]
+fn sensors_command_rejects_bad_input_in_one_line() {
+    let cache = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sensors_cli_cache_bad");
+    let scene_path = sideroom();
+    let scene = scene_path.to_str().unwrap();
+    let cases: [(&[&str], &str); 5] = [
+        (&["sensors", scene, "--date", "2026-03-21", "--time", "12:00", "--sky", "sunny"], "unknown sky 'sunny'"),
+        (&["sensors", scene, "--date", "2026-03-21", "--time", "12:00", "--sky", "perez"], "--sky perez"),
+        (&["sensors", scene, "--date", "2026-03-21", "--time", "12:00", "--sky", "perez", "--dni", "-3", "--dhi", "100"], "non-negative"),
+        (&["sensors", "no/such/scene.toml", "--date", "2026-03-21", "--time", "12:00"], "no/such/scene.toml: cannot read scene file"),
+        (&["sensors", scene, "--date", "2026-03-21", "--time", "25:00"], "--time"),
+    ];
+    for (args, expected) in cases {
+        let (code, out, err) = heliodon(args, &cache);
+        assert_ne!(code, 0, "{args:?}");
+        assert!(out.is_empty(), "{out}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.starts_with("error: ") && err.contains(expected), "{args:?}: {err}");
+    }
+    // Perez light with the sun down is refused, naming the case.
+    let (code, _, err) = heliodon(&["sensors", scene, "--date", "2026-03-21", "--time", "03:00", "--sky", "perez", "--dni", "100", "--dhi", "50"], &cache);
+    assert_ne!(code, 0);
+    assert!(err.contains("2026-03-21 03:00:00") && err.contains("below the horizon"), "{err}");
+}

@@ -13,13 +13,14 @@ use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task, block_on, futures_lite::future};
 
 use super::{ActiveScene, HeliodonSystems, LightChanged, SceneSpawned, SunSky};
-use crate::light::{LightModel, LightSettings, Lighting};
+use crate::light::{LightModel, LightSettings, Lighting, cache};
 
 pub struct LightingPlugin;
 
 impl Plugin for LightingPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<LightingSettings>()
+            .init_resource::<LightCacheDir>()
             .init_resource::<LightEngine>()
             .init_resource::<LightingState>()
             .add_message::<LightingUpdated>()
@@ -34,6 +35,16 @@ impl Plugin for LightingPlugin {
 /// Settings of the light engine for the next precomputation.
 #[derive(Resource, Debug, Clone, Copy, Default, PartialEq)]
 pub struct LightingSettings(pub LightSettings);
+
+/// Where precomputations are cached (`None`: not at all).
+#[derive(Resource, Debug, Clone, PartialEq)]
+pub struct LightCacheDir(pub Option<std::path::PathBuf>);
+
+impl Default for LightCacheDir {
+    fn default() -> Self {
+        Self(cache::default_dir())
+    }
+}
 
 /// The precomputed model and the work in flight.
 #[derive(Resource, Default)]
@@ -92,6 +103,7 @@ fn start_precompute(
     mut spawned: MessageReader<SceneSpawned>,
     active: Res<ActiveScene>,
     settings: Res<LightingSettings>,
+    cache_dir: Res<LightCacheDir>,
     mut engine: ResMut<LightEngine>,
     mut state: ResMut<LightingState>,
 ) {
@@ -104,7 +116,10 @@ fn start_precompute(
     engine.results = None;
     engine.generation.fetch_add(1, Ordering::SeqCst);
     *state = LightingState::default();
-    engine.precompute = Some(AsyncComputeTaskPool::get().spawn(async move { LightModel::precompute(scene, settings) }));
+    let dir = cache_dir.0.clone();
+    engine.precompute = Some(AsyncComputeTaskPool::get().spawn(async move {
+        cache::precompute_cached(scene, settings, dir.as_deref(), &|_| {}).map(|(model, _)| model)
+    }));
 }
 
 fn finish_precompute(mut engine: ResMut<LightEngine>, mut failed: MessageWriter<LightingFailed>) {

@@ -17,7 +17,7 @@ pub use scene_plugin::{
     ActiveScene, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, ScenePlugin, SceneRoot, SceneSpawned,
     SceneSurface, SceneSensor, SceneWindow, Site,
 };
-pub use lighting::{LightEngine, LightingFailed, LightingPlugin, LightingSettings, LightingState, LightingUpdated};
+pub use lighting::{LightCacheDir, LightEngine, LightingFailed, LightingPlugin, LightingSettings, LightingState, LightingUpdated};
 pub use sun_sky::{LightChanged, SkyChoice, SkyRejected, SkySubdivision, SolarTime, SunSky, SunSkyPlugin};
 
 /// The simulation plugins, in dependency order.

@@ -17,6 +17,7 @@
 //! Plain Rust, no Bevy types.
 
 mod bvh;
+pub mod cache;
 mod glass;
 mod sampling;
 
@@ -232,7 +233,38 @@ fn par_map<T: Send>(threads: Option<usize>, count: usize, f: impl Fn(usize) -> T
 impl LightModel {
     /// Traces everything that does not depend on the sun and sky.
     pub fn precompute(scene: Arc<Scene>, settings: LightSettings) -> Result<Self, String> {
+        Self::precompute_with_progress(scene, settings, &|_| {})
+    }
+
+    /// [`Self::precompute`], reporting the fraction done (0-1) now and then.
+    pub fn precompute_with_progress(scene: Arc<Scene>, settings: LightSettings, progress: &(dyn Fn(f64) + Sync)) -> Result<Self, String> {
         settings.check()?;
+        let mut model = Self::empty(scene, settings);
+        let patches = &model.scene.patches.patches;
+        let total = patches.len() * 2 + model.scene.sensors.len();
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let tick = || {
+            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            if n % 64 == 0 || n == total {
+                progress(n as f64 / total as f64);
+            }
+        };
+        model.side_gathers = par_map(model.settings.threads, patches.len() * 2, |side| {
+            let gather = model.gather_patch_side(side);
+            tick();
+            gather
+        });
+        let sensors = model.scene.sensors.clone();
+        model.sensors = par_map(model.settings.threads, sensors.len(), |i| {
+            let geometry = model.sensor_geometry(i, &sensors[i]);
+            tick();
+            geometry
+        });
+        Ok(model)
+    }
+
+    /// The model with its tracer and materials but nothing gathered yet.
+    fn empty(scene: Arc<Scene>, settings: LightSettings) -> Self {
         let tracer = Tracer::new(&scene.patches);
         let surfaces = scene
             .materials
@@ -243,7 +275,7 @@ impl LightModel {
                 MaterialKind::Panel { .. } => Surface::PassThrough,
             })
             .collect();
-        let mut model = Self {
+        Self {
             bins: SkyPatches::reinhart(settings.sky_subdivision),
             scene,
             settings,
@@ -251,12 +283,43 @@ impl LightModel {
             surfaces,
             side_gathers: Vec::new(),
             sensors: Vec::new(),
-        };
-        let patches = &model.scene.patches.patches;
-        model.side_gathers = par_map(model.settings.threads, patches.len() * 2, |side| model.gather_patch_side(side));
-        let sensors = model.scene.sensors.clone();
-        model.sensors = par_map(model.settings.threads, sensors.len(), |i| model.sensor_geometry(i, &sensors[i]));
-        Ok(model)
+        }
+    }
+
+    /// The gathered data, for the cache.
+    fn payload(&self) -> Vec<u8> {
+        let mut w = cache::Writer::default();
+        w.u32(self.side_gathers.len() as u32);
+        self.side_gathers.iter().for_each(|g| w.gather(g));
+        w.u32(self.sensors.len() as u32);
+        self.sensors.iter().for_each(|s| s.write(&mut w));
+        w.0
+    }
+
+    /// The model from cached data; `None` when it does not fit the scene.
+    fn from_payload(scene: Arc<Scene>, settings: LightSettings, payload: &[u8]) -> Option<Self> {
+        let mut r = cache::Reader(payload);
+        let sides = r.u32()? as usize;
+        if sides != scene.patches.patches.len() * 2 {
+            return None;
+        }
+        let side_gathers = (0..sides).map(|_| r.gather()).collect::<Option<Vec<_>>>()?;
+        let sensor_count = r.u32()? as usize;
+        if sensor_count != scene.sensors.len() {
+            return None;
+        }
+        let sensors = (0..sensor_count).map(|_| SensorGeometry::read(&mut r)).collect::<Option<Vec<_>>>()?;
+        let bins = 2 * SkyPatches::reinhart(settings.sky_subdivision).len() as u32;
+        let patch_sides = sides as u32;
+        let fits = |g: &Gather| g.bins.iter().all(|b| b.0 < bins) && g.sides.iter().all(|s| s.0 < patch_sides);
+        let hits_fit = |s: &SensorGeometry| s.hits.iter().all(|h| h.0 < patch_sides);
+        if !r.is_empty() || !side_gathers.iter().all(fits) || !sensors.iter().all(|s| fits(&s.gather) && hits_fit(s)) {
+            return None;
+        }
+        let mut model = Self::empty(scene, settings);
+        model.side_gathers = side_gathers;
+        model.sensors = sensors;
+        Some(model)
     }
 
     fn surface_of_patch(&self, patch: u32) -> Surface {
