@@ -46,6 +46,9 @@ pub enum Command {
     /// Illuminance at the scene's sensors (lux): total, direct sun, direct sky, indirect
     #[command(allow_negative_numbers = true)]
     Sensors(SensorsArgs),
+    /// Write a Radiance model of the scene, sky and sensors, with a run.sh that computes the sensors in Radiance
+    #[command(name = "export-radiance", allow_negative_numbers = true)]
+    ExportRadiance(ExportArgs),
     /// Sun position (NREL SPA) for a site and a local standard time, or the day's sunrise, noon and sunset
     #[command(allow_negative_numbers = true)]
     Sun(SunArgs),
@@ -101,6 +104,23 @@ pub struct SensorsArgs {
     /// Neither read nor write the precomputation cache
     #[arg(long)]
     pub no_cache: bool,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct ExportArgs {
+    /// Scene file (TOML)
+    pub scene: PathBuf,
+    /// Local date, YYYY-MM-DD
+    #[arg(long, value_parser = Date::parse)]
+    pub date: Date,
+    /// Local standard time, HH:MM
+    #[arg(long, value_parser = TimeOfDay::parse)]
+    pub time: TimeOfDay,
+    #[command(flatten)]
+    pub sky: SkyArgs,
+    /// Folder to write scene.rad, sky.rad, sensors.pts, sensors.txt and run.sh into
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
 /// The sky flags shared by the commands that light a scene.
@@ -209,6 +229,13 @@ pub fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         },
+        Some(Command::ExportRadiance(args)) => match export_radiance(&args) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(error) => {
+                eprintln!("error: {error}");
+                ExitCode::FAILURE
+            }
+        },
         Some(Command::Sun(args)) => {
             print!("{}", sun_report(&args));
             ExitCode::SUCCESS
@@ -224,15 +251,47 @@ fn progress_bar(fraction: f64) {
     }
 }
 
-/// The `sensors` command: one precomputation, then every date × time.
-pub fn sensors(args: &SensorsArgs) -> Result<String, String> {
-    let spec = args.sky.spec()?;
-    let loaded = scene::load_scene(&args.scene, &PanelRegistry::default().names()).map_err(|e| e.to_string())?;
+/// Loads a scene for a command, printing its warnings.
+fn load_for_command(path: &std::path::Path) -> Result<Scene, String> {
+    let loaded = scene::load_scene(path, &PanelRegistry::default().names()).map_err(|e| e.to_string())?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
-    let scene = std::sync::Arc::new(loaded.scene);
-    let site = scene.site;
+    Ok(loaded.scene)
+}
+
+/// The sun and sky of a scene's site at a local time.
+fn sky_for(scene: &Scene, spec: &SkySpec, sky_name: &str, when: LocalDateTime) -> Result<(SolarPosition, Sky), String> {
+    let position = sun::solar_position(&scene.site, &when);
+    let sky = Sky::new(spec, position.altitude, position.azimuth, scene.site.ground_reflectance, when.date.day_of_year())
+        .map_err(|e| format!("--sky {sky_name} on {} {}: {e}", when.date, when.time))?;
+    Ok((position, sky))
+}
+
+/// The `export-radiance` command.
+pub fn export_radiance(args: &ExportArgs) -> Result<(), String> {
+    let spec = args.sky.spec()?;
+    let scene = load_for_command(&args.scene)?;
+    let when = LocalDateTime { date: args.date, time: args.time };
+    let (position, sky) = sky_for(&scene, &spec, &args.sky.sky, when)?;
+    let case = format!(
+        "{} {} {} sky, sun altitude {:.4}°, azimuth {:.4}° (SPA)",
+        when.date, when.time, args.sky.sky, position.altitude, position.azimuth
+    );
+    crate::radiance::export(&scene, &sky, &case, &args.out)
+}
+
+/// The `sensors` command: one precomputation, then every date × time.
+pub fn sensors(args: &SensorsArgs) -> Result<String, String> {
+    let spec = args.sky.spec()?;
+    let scene = std::sync::Arc::new(load_for_command(&args.scene)?);
+    for i in crate::light::sensors_inside_solids(&scene) {
+        eprintln!(
+            "warning: {}: sensor '{}' seems to be inside a solid (every direction meets a back face); it reads what reaches it there",
+            args.scene.display(),
+            scene.sensors[i].name
+        );
+    }
     let cache_dir = if args.no_cache { None } else { cache::default_dir() };
     let (model, _) = cache::precompute_cached(scene.clone(), LightSettings::default(), cache_dir.as_deref(), &progress_bar)?;
     if std::io::stderr().is_terminal() {
@@ -248,9 +307,7 @@ pub fn sensors(args: &SensorsArgs) -> Result<String, String> {
     }
     let mut json = Vec::new();
     for when in cases {
-        let position = sun::solar_position(&site, &when);
-        let sky = Sky::new(&spec, position.altitude, position.azimuth, site.ground_reflectance, when.date.day_of_year())
-            .map_err(|e| format!("--sky {} on {} {}: {e}", args.sky.sky, when.date, when.time))?;
+        let (position, sky) = sky_for(&scene, &spec, &args.sky.sky, when)?;
         let lighting = model.solve(&sky, previous.as_ref());
         match args.format {
             Format::Csv => {

@@ -5,11 +5,12 @@
 //!   [`sun`], [`sky`], [`light`];
 //! - the ECS layer: [`ecs`] ([`HeliodonPlugins`], runs headless);
 //! - drawing: [`render`]; the window and its input: [`viewer`];
-//! - the command line: [`cli`].
+//! - the command line: [`cli`]; Radiance export: [`radiance`].
 
 pub mod cli;
 pub mod ecs;
 pub mod light;
+pub mod radiance;
 pub mod render;
 pub mod scene;
 pub mod site;

@@ -255,3 +255,66 @@ fn sensors_command_rejects_bad_input_in_one_line() {
     assert_ne!(code, 0);
     assert!(err.contains("2026-03-21 03:00:00") && err.contains("below the horizon"), "{err}");
 }
+
+#[test]
+fn export_radiance_writes_the_same_model_and_sky() {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("export_test_room");
+    let _ = std::fs::remove_dir_all(&out);
+    let scene_path = heliodon::bundled_scene("test_room");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_heliodon"))
+        .args(["export-radiance", scene_path.to_str().unwrap(), "--date", "2026-03-21", "--time", "10:00", "--sky", "clear", "--out", out.to_str().unwrap()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let scene = load(&scene_path);
+    let rad = std::fs::read_to_string(out.join("scene.rad")).unwrap();
+    assert_eq!(rad.matches(" polygon ").count(), scene.triangles.len());
+    assert!(rad.contains("void glass m_glass\n0\n0\n3 0.9"), "Radiance transmissivity of 88% glass is 0.96");
+    let sky_rad = std::fs::read_to_string(out.join("sky.rad")).unwrap();
+    let sky = sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-03-21", "10:00");
+    let (zenith, f2) = sky.gensky_arguments().unwrap();
+    assert!(sky_rad.contains(&format!("7 1 {zenith:.9e} {:.9e} {f2:.9e}", sky.ground_radiance)), "{sky_rad}");
+    assert!(sky_rad.contains(&format!("3 {r:.6e} {r:.6e} {r:.6e}", r = sky.sun.unwrap().radiance)));
+    let points = std::fs::read_to_string(out.join("sensors.pts")).unwrap();
+    let index = std::fs::read_to_string(out.join("sensors.txt")).unwrap();
+    let expected: usize = scene.sensors.iter().map(|s| if s.size.is_some() { 16 } else { 1 }).sum();
+    assert_eq!(points.lines().count(), expected);
+    assert_eq!(index.lines().count(), scene.sensors.len());
+    assert!(std::fs::read_to_string(out.join("run.sh")).unwrap().contains("rtrace -h -I -ab 16"));
+    // The floor sensor lies on the floor: it is exported lifted 1 cm, as heliodon reads it.
+    let floor = index.lines().position(|l| l.starts_with("floor-centre ")).unwrap();
+    let first_point: usize = index.lines().take(floor).map(|l| l.split(' ').nth(1).unwrap().parse::<usize>().unwrap()).sum();
+    let z: f64 = points.lines().nth(first_point).unwrap().split(' ').nth(2).unwrap().parse().unwrap();
+    assert!((z - 0.01).abs() < 1e-6, "{z}");
+}
+
+#[test]
+fn open_models_and_sensors_inside_solids_are_handled() {
+    // Without its ceiling the room leaks light: that is the model's truth.
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_open");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(sideroom(), dir.join("scene.toml")).unwrap();
+    std::fs::copy(sideroom().with_file_name("model.mtl"), dir.join("model.mtl")).unwrap();
+    let obj = std::fs::read_to_string(sideroom().with_file_name("model.obj")).unwrap();
+    let open: String = obj.lines().filter(|l| !l.starts_with("usemtl ceiling")).collect::<Vec<_>>().join("\n");
+    let open = open.replace("\nf 5 6 7 8", "");
+    std::fs::write(dir.join("model.obj"), open).unwrap();
+    let scene = load(&dir.join("scene.toml"));
+    let model = LightModel::precompute(scene.clone(), quick()).unwrap();
+    let lighting = model.solve(&sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "12:00"), None);
+    assert!(lighting.sensors.iter().all(|r| r.total.is_finite() && r.total > 0.0));
+    // A sensor inside the test room's closed desk-like box is flagged.
+    let office = load(&heliodon::bundled_scene("office"));
+    assert!(heliodon::light::sensors_inside_solids(&office).is_empty());
+    let inside = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_inside");
+    std::fs::create_dir_all(&inside).unwrap();
+    let scene_text = std::fs::read_to_string(heliodon::bundled_scene("office")).unwrap()
+        + "\n[[sensors]]\nname = \"in-partition\"\nposition = [4.0, 4.0, 0.6]\nnormal = [0.0, 0.0, 1.0]\n";
+    std::fs::write(inside.join("scene.toml"), scene_text).unwrap();
+    for f in ["model.obj", "model.mtl"] {
+        std::fs::copy(heliodon::bundled_scene("office").with_file_name(f), inside.join(f)).unwrap();
+    }
+    let scene = load(&inside.join("scene.toml"));
+    let flagged = heliodon::light::sensors_inside_solids(&scene);
+    assert_eq!(flagged.iter().map(|&i| scene.sensors[i].name.as_str()).collect::<Vec<_>>(), ["in-partition"]);
+}

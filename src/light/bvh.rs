@@ -46,6 +46,9 @@ impl Tracer {
 
     /// The closest hit beyond `t_min` along a unit direction.
     pub fn closest(&self, origin: DVec3, direction: DVec3, t_min: f64) -> Option<Hit> {
+        // obvhs picks the traversal octant from the sign bits: a −0.0 component
+        // (from negating an axis) must become +0.0 or axis-aligned rays miss.
+        let direction = direction + DVec3::ZERO;
         let ray = Ray::new(to_bvh(origin), to_bvh(direction), t_min as f32, f32::INFINITY);
         let mut hit = RayHit::none();
         self.bvh
@@ -54,5 +57,36 @@ impl Tracer {
                 patch: self.owner[self.bvh.primitive_indices[hit.primitive_id as usize] as usize],
                 distance: f64::from(hit.t),
             })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Patch, PatchMesh};
+    use glam::Vec3;
+
+    #[test]
+    fn axis_aligned_rays_with_negative_zeros_hit() {
+        let mesh = PatchMesh {
+            patches: vec![Patch {
+                surface: 0,
+                material: 0,
+                area: 1.0,
+                normal: Vec3::Z,
+                centroid: Vec3::ZERO,
+                triangles: 0..2,
+            }],
+            triangles: vec![
+                [Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0)],
+                [Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, 1.0, 0.0)],
+            ],
+        };
+        let tracer = Tracer::new(&mesh);
+        for origin in [DVec3::new(0.0, 0.0, 0.5), DVec3::new(0.3, -0.2, 0.5)] {
+            let hit = tracer.closest(origin, -DVec3::Z, 0.0).expect("straight down hits");
+            assert!((hit.distance - 0.5).abs() < 1e-6);
+        }
+        assert!(tracer.closest(DVec3::new(0.0, 0.0, 0.5), DVec3::Z, 0.0).is_none());
     }
 }

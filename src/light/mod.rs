@@ -409,26 +409,10 @@ impl LightModel {
 
     fn sensor_geometry(&self, index: usize, sensor: &Sensor) -> SensorGeometry {
         let normal = sensor.normal.as_dvec3();
-        let mut centre = sensor.position.as_dvec3();
-        // Lying on a surface (within the lift, facing away from it): lift it.
-        if let Some(hit) = self.tracer.closest(centre + normal * SENSOR_LIFT, -normal, 0.0)
-            && hit.distance <= SENSOR_LIFT * 1.01
-        {
-            centre += normal * (SENSOR_LIFT - (hit.distance - SENSOR_LIFT)).max(0.0);
-        }
-        let [u, v] = sensor.axes.map(|a| a.as_dvec3());
-        let grid = |n: usize| -> Vec<DVec3> {
-            let size = f64::from(sensor.size.unwrap_or(0.0));
-            (0..n * n)
-                .map(|k| {
-                    let (i, j) = ((k % n) as f64, (k / n) as f64);
-                    centre + u * size * ((i + 0.5) / n as f64 - 0.5) + v * size * ((j + 0.5) / n as f64 - 0.5)
-                })
-                .collect()
-        };
-        let (points, sun_points) = match sensor.size {
-            Some(_) => (grid(4), grid(self.settings.area_sensor_sun_grid)),
-            None => (vec![centre], vec![centre]),
+        let points = place_sensor(&self.tracer, sensor, 4);
+        let sun_points = match sensor.size {
+            Some(_) => place_sensor(&self.tracer, sensor, self.settings.area_sensor_sun_grid),
+            None => points.clone(),
         };
         let mut rng = Rng::new(2, index as u64);
         let per_point = self.settings.rays_per_sensor.div_ceil(points.len());
@@ -640,6 +624,61 @@ impl Relight<'_> {
             .collect();
         Lighting { sides, sensors, iterations: self.iterations }
     }
+}
+
+/// Where a sensor measures: its position, or an n × n grid of cell centres
+/// over its square, lifted off a surface it lies on.
+fn place_sensor(tracer: &Tracer, sensor: &Sensor, n: usize) -> Vec<DVec3> {
+    let normal = sensor.normal.as_dvec3();
+    let [u, v] = sensor.axes.map(|a| a.as_dvec3());
+    let mut centre = sensor.position.as_dvec3();
+    // Lying on a surface (within the lift, facing away from it): lift it.
+    // Probe beside the point too, in case a ray down a shared edge slips between triangles.
+    let probes = [DVec3::ZERO, u * 1e-4, v * 1e-4, -(u + v) * 1e-4];
+    let gap = probes
+        .iter()
+        .filter_map(|&o| tracer.closest(centre + o + normal * SENSOR_LIFT, -normal, 0.0))
+        .map(|hit| hit.distance - SENSOR_LIFT)
+        .fold(f64::INFINITY, f64::min);
+    if gap <= SENSOR_LIFT * 0.01 {
+        centre += normal * (SENSOR_LIFT - gap.max(-SENSOR_LIFT)).max(0.0);
+    }
+    let Some(size) = sensor.size else { return vec![centre] };
+    let size = f64::from(size);
+    (0..n * n)
+        .map(|k| {
+            let (i, j) = ((k % n) as f64, (k / n) as f64);
+            centre + u * size * ((i + 0.5) / n as f64 - 0.5) + v * size * ((j + 0.5) / n as f64 - 0.5)
+        })
+        .collect()
+}
+
+/// Sensors that seem to sit inside a solid: every ray from them meets a
+/// surface from its back, within a few metres. They still read what reaches
+/// them; the caller warns.
+pub fn sensors_inside_solids(scene: &Scene) -> Vec<usize> {
+    const RAYS: usize = 64;
+    let tracer = Tracer::new(&scene.patches);
+    let patches = &scene.patches.patches;
+    (0..scene.sensors.len())
+        .filter(|&i| {
+            let position = scene.sensors[i].position.as_dvec3();
+            let mut rng = Rng::new(4, i as u64);
+            let up = cosine_directions(DVec3::Z, RAYS / 2, &mut rng);
+            up.iter().chain(cosine_directions(DVec3::NEG_Z, RAYS / 2, &mut rng).iter()).all(|&d| {
+                tracer
+                    .closest(position, d, 1e-6)
+                    .is_some_and(|hit| hit.distance < 5.0 && d.dot(patches[hit.patch as usize].normal.as_dvec3()) > 0.0)
+            })
+        })
+        .collect()
+}
+
+/// Every sensor's measuring points as [`LightModel`] places them (area
+/// sensors: a 4 × 4 grid), for exporting them.
+pub fn sensor_points(scene: &Scene) -> Vec<Vec<DVec3>> {
+    let tracer = Tracer::new(&scene.patches);
+    scene.sensors.iter().map(|s| place_sensor(&tracer, s, 4)).collect()
 }
 
 /// A uniformly distributed point on triangles given with cumulative areas.

@@ -67,6 +67,11 @@ impl Cie {
         self.indicatrix(chi) * self.gradation(d.z) / self.at_zenith
     }
 
+    /// Scale (Lz / (f(Zs)·φ(0))), the parameters and the sun: a .cal file's arguments.
+    pub fn arguments(&self) -> (f64, [f64; 5], DVec3) {
+        (self.zenith / self.at_zenith, self.parameters, self.sun)
+    }
+
     /// The sky term (before the blend into the ground glow).
     pub fn sky(&self, d: DVec3) -> f64 {
         self.zenith * self.relative(d)

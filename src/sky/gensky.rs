@@ -143,6 +143,11 @@ impl Gensky {
         }
     }
 
+    /// The sun direction the sky function uses (lowered to 87° for sunny skies).
+    pub fn sun_for_sky(&self) -> DVec3 {
+        self.sun
+    }
+
     /// The skyfunc arguments gensky prints (A2, A4), for comparisons.
     pub fn arguments(&self) -> (f64, f64) {
         (self.zenith, self.f2)

@@ -6,6 +6,7 @@
 //! "visible watts", 179 lm/W. Plain Rust, no Bevy types.
 
 pub mod cie;
+mod export;
 pub mod gensky;
 pub mod patches;
 pub mod perez;
@@ -15,6 +16,7 @@ use std::fmt;
 
 use glam::DVec3;
 
+pub use export::radiance_sky;
 pub use patches::SkyPatches;
 
 /// Radiance's luminous efficacy for reporting (lm/W).

@@ -240,6 +240,11 @@ impl Perez {
         self.normalisation * relative_luminance(&self.coefficients, d.z.max(0.01), gamma)
     }
 
+    /// The sun direction the sky function uses (lowered to 87°).
+    pub fn sun_for_sky(&self) -> DVec3 {
+        self.sun
+    }
+
     /// The skyfunc arguments gendaylit prints: normalisation and a..e.
     pub fn arguments(&self) -> (f64, [f64; 5]) {
         (self.normalisation, self.coefficients)
