@@ -48,7 +48,14 @@ pub struct Computed {
 
 /// Quadrature for the normalisation: fine enough for 0.1% on the sharpest
 /// corona (type 15).
-const NORMALISATION_STEPS: (usize, usize) = (90, 180);
+const NORMALISATION_STEPS: (usize, usize) = (60, 120);
+
+/// ∫ (1 − w)·cos dω over the upper hemisphere: the ground glow's share of
+/// the horizontal light, the same for every sky.
+fn ground_share() -> f64 {
+    static SHARE: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
+    *SHARE.get_or_init(|| integrate_hemisphere(|d| 1.0 - blend_weight(d.z), (400, 8)).1)
+}
 
 impl Cie {
     fn gradation(&self, cos_z: f64) -> f64 {
@@ -101,8 +108,7 @@ pub fn compute(
     // The blended sky (sky term and ground glow) must give `diffuse` on the
     // horizontal: diffuse = Lz·∫ w·rel·cos + ground·∫ (1−w)·cos.
     let (_, sky_part) = integrate_hemisphere(|d| blend_weight(d.z) * cie.relative(d), NORMALISATION_STEPS);
-    let (_, ground_part) = integrate_hemisphere(|d| 1.0 - blend_weight(d.z), NORMALISATION_STEPS);
-    cie.zenith = ((diffuse - ground * ground_part) / sky_part).max(0.0);
+    cie.zenith = ((diffuse - ground * ground_share()) / sky_part).max(0.0);
     Computed {
         zenith_radiance: cie.zenith,
         distribution: cie,

@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use super::{SKY_EFFICACY, SUN_EFFICACY, SunSource};
+use super::{SKY_EFFICACY, SUN_EFFICACY, SkyDirection, SunSource};
 use crate::sun::direction_from_angles;
 
 /// gensky's sun: a disc 0.5° across.
@@ -120,23 +120,23 @@ pub fn compute(kind: Kind, turbidity: f64, altitude: f64, azimuth: f64, ground_r
 
 impl Gensky {
     /// skybright.cal's sky term (before the blend into the ground glow).
-    pub fn sky(&self, d: DVec3) -> f64 {
+    pub fn sky(&self, direction: &SkyDirection) -> f64 {
+        let d = direction.d;
         match self.kind {
             Kind::Uniform => self.zenith,
             Kind::Overcast => self.zenith * (1.0 + 2.0 * d.z) / 3.0,
             Kind::Clear => {
                 let cos_gamma = d.dot(self.sun).clamp(-1.0, 1.0);
                 let gamma = cos_gamma.acos();
-                let horizon = if d.z > 0.01 { 1.0 - (-0.32 / d.z).exp() } else { 1.0 };
-                self.zenith * (0.91 + 10.0 * (-3.0 * gamma).exp() + 0.45 * cos_gamma * cos_gamma) * horizon / self.f2
+                self.zenith * (0.91 + 10.0 * (-3.0 * gamma).exp() + 0.45 * cos_gamma * cos_gamma) * direction.clear_horizon
+                    / self.f2
             }
             Kind::Intermediate => {
                 let gamma = d.dot(self.sun).clamp(-1.0, 1.0).acos();
-                let eta = d.z.clamp(-1.0, 1.0).acos();
+                let eta = direction.eta;
                 let zt = self.sun_zenith;
-                self.zenith
-                    * ((1.35 * (5.631 - 3.59 * eta).sin() + 3.12) * (4.396 - 2.6 * zt).sin() + 6.37 - eta)
-                    / 2.326
+                let sun_term = (4.396 - 2.6 * zt).sin();
+                self.zenith * (direction.intermediate_eta * sun_term + 6.37 - eta) / 2.326
                     * (gamma * -0.563 * ((2.629 - eta) * (1.562 - zt) + 0.812)).exp()
                     / self.f2
             }

@@ -214,6 +214,34 @@ pub struct Sky {
     distribution: Distribution,
 }
 
+/// A direction with the terms of the sky functions that depend on it alone,
+/// so that integrating a sky over fixed directions computes them once.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SkyDirection {
+    pub d: DVec3,
+    /// [`blend_weight`] of `d.z`.
+    blend: f64,
+    /// Zenith angle, radians.
+    eta: f64,
+    /// The clear sky's horizon term, 1 − exp(−0.32/Dz) above Dz = 0.01.
+    clear_horizon: f64,
+    /// The intermediate sky's 1.35·sin(5.631 − 3.59η) + 3.12.
+    intermediate_eta: f64,
+}
+
+impl SkyDirection {
+    pub fn new(d: DVec3) -> Self {
+        let eta = d.z.clamp(-1.0, 1.0).acos();
+        Self {
+            d,
+            blend: blend_weight(d.z),
+            eta,
+            clear_horizon: if d.z > 0.01 { 1.0 - (-0.32 / d.z).exp() } else { 1.0 },
+            intermediate_eta: 1.35 * (5.631 - 3.59 * eta).sin() + 3.12,
+        }
+    }
+}
+
 /// Weight of the sky term against the ground glow (skybright.cal):
 /// (Dz+1.01)^10 / ((Dz+1.01)^10 + (Dz+1.01)^−10).
 pub fn blend_weight(dz: f64) -> f64 {
@@ -312,14 +340,18 @@ impl Sky {
     /// unit direction `d`, without the sun: the sky term blended into the
     /// ground glow around the horizon as skybright.cal does.
     pub fn radiance(&self, d: DVec3) -> f64 {
+        self.radiance_toward(&SkyDirection::new(d))
+    }
+
+    /// [`Self::radiance`] for a direction whose own terms are computed already.
+    pub fn radiance_toward(&self, d: &SkyDirection) -> f64 {
         let sky = match &self.distribution {
             Distribution::Dark => return 0.0,
             Distribution::Gensky(g) => g.sky(d),
-            Distribution::Perez(p) => p.sky(d),
-            Distribution::Cie(c) => c.sky(d),
+            Distribution::Perez(p) => p.sky(d.d),
+            Distribution::Cie(c) => c.sky(d.d),
         };
-        let w = blend_weight(d.z);
-        w * sky + (1.0 - w) * self.ground_radiance
+        d.blend * sky + (1.0 - d.blend) * self.ground_radiance
     }
 
     /// The gensky distribution's printed arguments, for comparisons.

@@ -9,7 +9,7 @@ use std::ops::Range;
 
 use glam::DVec3;
 
-use super::Sky;
+use super::{Sky, SkyDirection};
 use crate::sun::direction_from_angles;
 
 /// Patches per Tregenza row, horizon first.
@@ -37,7 +37,9 @@ pub struct SkyPatches {
     /// Reinhart's MF (1 for Tregenza).
     pub subdivision: u32,
     pub patches: Vec<SkyPatch>,
-    samples: Vec<DVec3>,
+    /// Quadrature directions above the horizon, and their mirrors below.
+    samples: Vec<SkyDirection>,
+    mirrored: Vec<SkyDirection>,
     sample_ranges: Vec<Range<u32>>,
 }
 
@@ -82,7 +84,9 @@ impl SkyPatches {
                 });
             }
         }
-        Self { subdivision: n, patches, samples, sample_ranges }
+        let mirrored = samples.iter().map(|d: &DVec3| SkyDirection::new(DVec3::new(d.x, d.y, -d.z))).collect();
+        let samples = samples.into_iter().map(SkyDirection::new).collect();
+        Self { subdivision: n, patches, samples, mirrored, sample_ranges }
     }
 
     pub fn len(&self) -> usize {
@@ -117,9 +121,13 @@ impl SkyPatches {
     /// Each patch's mean radiance under `sky` (sun excluded), into `out`.
     pub fn integrate_into(&self, sky: &Sky, out: &mut Vec<f64>) {
         out.clear();
+        self.extend_means(sky, &self.samples, out);
+    }
+
+    fn extend_means(&self, sky: &Sky, samples: &[SkyDirection], out: &mut Vec<f64>) {
         out.extend(self.sample_ranges.iter().map(|range| {
-            let cells = &self.samples[range.start as usize..range.end as usize];
-            cells.iter().map(|&d| sky.radiance(d)).sum::<f64>() / cells.len() as f64
+            let cells = &samples[range.start as usize..range.end as usize];
+            cells.iter().map(|d| sky.radiance_toward(d)).sum::<f64>() / cells.len() as f64
         }));
     }
 
@@ -141,10 +149,7 @@ impl SkyPatches {
     /// Mean radiance of every sphere bin ([`Self::sphere_bin`]) under `sky`, sun excluded.
     pub fn integrate_sphere_into(&self, sky: &Sky, out: &mut Vec<f64>) {
         self.integrate_into(sky, out);
-        out.extend(self.sample_ranges.iter().map(|range| {
-            let cells = &self.samples[range.start as usize..range.end as usize];
-            cells.iter().map(|&d| sky.radiance(DVec3::new(d.x, d.y, -d.z))).sum::<f64>() / cells.len() as f64
-        }));
+        self.extend_means(sky, &self.mirrored, out);
     }
 
     /// Total solid angle: 2π up to rounding.
