@@ -285,17 +285,17 @@ pub fn export_radiance(args: &ExportArgs) -> Result<(), String> {
 pub fn sensors(args: &SensorsArgs) -> Result<String, String> {
     let spec = args.sky.spec()?;
     let scene = std::sync::Arc::new(load_for_command(&args.scene)?);
-    for i in crate::light::sensors_inside_solids(&scene) {
+    let cache_dir = if args.no_cache { None } else { cache::default_dir() };
+    let (model, _) = cache::precompute_cached(scene.clone(), LightSettings::default(), cache_dir.as_deref(), &progress_bar)?;
+    if std::io::stderr().is_terminal() {
+        eprint!("\r{:60}\r", "");
+    }
+    for i in model.sensors_inside_solids() {
         eprintln!(
             "warning: {}: sensor '{}' seems to be inside a solid (every direction meets a back face); it reads what reaches it there",
             args.scene.display(),
             scene.sensors[i].name
         );
-    }
-    let cache_dir = if args.no_cache { None } else { cache::default_dir() };
-    let (model, _) = cache::precompute_cached(scene.clone(), LightSettings::default(), cache_dir.as_deref(), &progress_bar)?;
-    if std::io::stderr().is_terminal() {
-        eprint!("\r{:60}\r", "");
     }
     let cases: Vec<LocalDateTime> =
         args.date.iter().flat_map(|&date| args.time.iter().map(move |&time| LocalDateTime { date, time })).collect();

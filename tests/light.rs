@@ -305,7 +305,7 @@ fn open_models_and_sensors_inside_solids_are_handled() {
     assert!(lighting.sensors.iter().all(|r| r.total.is_finite() && r.total > 0.0));
     // A sensor inside the test room's closed desk-like box is flagged.
     let office = load(&heliodon::bundled_scene("office"));
-    assert!(heliodon::light::sensors_inside_solids(&office).is_empty());
+    assert!(LightModel::precompute(office, quick()).unwrap().sensors_inside_solids().is_empty());
     let inside = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_inside");
     std::fs::create_dir_all(&inside).unwrap();
     let scene_text = std::fs::read_to_string(heliodon::bundled_scene("office")).unwrap()
@@ -315,6 +315,6 @@ fn open_models_and_sensors_inside_solids_are_handled() {
         std::fs::copy(heliodon::bundled_scene("office").with_file_name(f), inside.join(f)).unwrap();
     }
     let scene = load(&inside.join("scene.toml"));
-    let flagged = heliodon::light::sensors_inside_solids(&scene);
+    let flagged = LightModel::precompute(scene.clone(), quick()).unwrap().sensors_inside_solids();
     assert_eq!(flagged.iter().map(|&i| scene.sensors[i].name.as_str()).collect::<Vec<_>>(), ["in-partition"]);
 }

@@ -15,7 +15,7 @@ use crate::scene::Scene;
 
 const MAGIC: &[u8; 8] = b"HELIOLT\0";
 /// Bump when the model or its layout changes.
-const FORMAT: u32 = 1;
+const FORMAT: u32 = 2;
 
 /// What happened to the cache.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -243,8 +243,6 @@ impl Reader<'_> {
 
 impl SensorGeometry {
     pub(super) fn write(&self, w: &mut Writer) {
-        w.u32(self.points.len() as u32);
-        self.points.iter().for_each(|&p| w.vec3(p));
         w.u32(self.sun_points.len() as u32);
         self.sun_points.iter().for_each(|&p| w.vec3(p));
         w.vec3(self.normal);
@@ -260,13 +258,11 @@ impl SensorGeometry {
     pub(super) fn read(r: &mut Reader) -> Option<Self> {
         let count = |r: &mut Reader, size: usize| r.u32().map(|n| n as usize).filter(|&n| n <= r.0.len() / size);
         let n = count(r, 24)?;
-        let points = (0..n).map(|_| r.vec3()).collect::<Option<Vec<_>>>()?;
-        let n = count(r, 24)?;
         let sun_points = (0..n).map(|_| r.vec3()).collect::<Option<Vec<_>>>()?;
         let normal = r.vec3()?;
         let gather = r.gather()?;
         let n = count(r, 20)?;
         let hits = (0..n).map(|_| Some((r.u32()?, r.f32()?, [r.f32()?, r.f32()?, r.f32()?]))).collect::<Option<Vec<_>>>()?;
-        Some(Self { points, sun_points, normal, gather, hits })
+        Some(Self { sun_points, normal, gather, hits })
     }
 }

@@ -164,8 +164,6 @@ pub struct LightModel {
 }
 
 struct SensorGeometry {
-    /// Points that gather sky and indirect light (one, or a 4 × 4 grid).
-    points: Vec<DVec3>,
     /// Points whose direct sun is averaged.
     sun_points: Vec<DVec3>,
     normal: DVec3,
@@ -424,7 +422,7 @@ impl LightModel {
         }
         let rays = per_point * points.len();
         let hits = sides.iter().map(|h| (h.side, (h.weight / rays as f64) as f32, h.point.as_vec3().to_array())).collect();
-        SensorGeometry { gather: Gather::from_raw(bins, &sides, rays), points, sun_points, normal, hits }
+        SensorGeometry { gather: Gather::from_raw(bins, &sides, rays), sun_points, normal, hits }
     }
 
     /// The light for a sky (and its sun), iterated to convergence. `warm` is
@@ -512,10 +510,6 @@ impl LightModel {
         }
     }
 
-    /// How many sensor points gather light (for reports).
-    pub fn sensor_points(&self) -> usize {
-        self.sensors.iter().map(|s| s.points.len()).sum()
-    }
 }
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -572,10 +566,6 @@ impl Relight<'_> {
         self.iterations += 1;
         self.converged = change <= model.settings.tolerance || self.iterations >= model.settings.max_iterations;
         self.converged
-    }
-
-    pub fn iterations(&self) -> usize {
-        self.iterations
     }
 
     pub fn is_converged(&self) -> bool {
@@ -653,25 +643,26 @@ fn place_sensor(tracer: &Tracer, sensor: &Sensor, n: usize) -> Vec<DVec3> {
         .collect()
 }
 
-/// Sensors that seem to sit inside a solid: every ray from them meets a
-/// surface from its back, within a few metres. They still read what reaches
-/// them; the caller warns.
-pub fn sensors_inside_solids(scene: &Scene) -> Vec<usize> {
-    const RAYS: usize = 64;
-    let tracer = Tracer::new(&scene.patches);
-    let patches = &scene.patches.patches;
-    (0..scene.sensors.len())
-        .filter(|&i| {
-            let position = scene.sensors[i].position.as_dvec3();
-            let mut rng = Rng::new(4, i as u64);
-            let up = cosine_directions(DVec3::Z, RAYS / 2, &mut rng);
-            up.iter().chain(cosine_directions(DVec3::NEG_Z, RAYS / 2, &mut rng).iter()).all(|&d| {
-                tracer
-                    .closest(position, d, 1e-6)
-                    .is_some_and(|hit| hit.distance < 5.0 && d.dot(patches[hit.patch as usize].normal.as_dvec3()) > 0.0)
+impl LightModel {
+    /// Sensors that seem to sit inside a solid: every ray from them meets a
+    /// surface from its back, within a few metres. They still read what
+    /// reaches them; the caller warns.
+    pub fn sensors_inside_solids(&self) -> Vec<usize> {
+        const RAYS: usize = 64;
+        let patches = &self.scene.patches.patches;
+        (0..self.scene.sensors.len())
+            .filter(|&i| {
+                let position = self.scene.sensors[i].position.as_dvec3();
+                let mut rng = Rng::new(4, i as u64);
+                let up = cosine_directions(DVec3::Z, RAYS / 2, &mut rng);
+                up.iter().chain(cosine_directions(DVec3::NEG_Z, RAYS / 2, &mut rng).iter()).all(|&d| {
+                    self.tracer
+                        .closest(position, d, 1e-6)
+                        .is_some_and(|hit| hit.distance < 5.0 && d.dot(patches[hit.patch as usize].normal.as_dvec3()) > 0.0)
+                })
             })
-        })
-        .collect()
+            .collect()
+    }
 }
 
 /// Every sensor's measuring points as [`LightModel`] places them (area

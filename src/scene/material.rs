@@ -18,12 +18,6 @@ impl Rgb {
     pub fn grey(v: f32) -> Self {
         Self([v; 3])
     }
-
-    /// Photometric weight of the triple with Radiance's coefficients.
-    pub fn luminance(self) -> f32 {
-        let [r, g, b] = self.0;
-        0.265 * r + 0.670 * g + 0.065 * b
-    }
 }
 
 #[derive(Debug, Clone, PartialEq)]

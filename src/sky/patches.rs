@@ -156,11 +156,6 @@ impl SkyPatches {
     pub fn total_solid_angle(&self) -> f64 {
         self.patches.iter().map(|p| p.solid_angle).sum()
     }
-
-    /// Number of quadrature directions (for benchmarks and budgets).
-    pub fn sample_count(&self) -> usize {
-        self.samples.len()
-    }
 }
 
 #[cfg(test)]
