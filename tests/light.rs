@@ -93,6 +93,34 @@ fn a_sensor_outside_reads_the_open_sky() {
     assert!((roof.direct_sky / 179.0 / diffuse - 1.0).abs() < 0.01, "{} vs {}", roof.direct_sky / 179.0, diffuse);
     // Nothing above the roof reflects light down on it.
     assert_eq!(roof.indirect, 0.0);
+    // Its sky is seen straight, not through a window.
+    let by_window = &model.sky_through_windows(&sky)[0];
+    assert!(by_window.iter().all(|(window, _)| window.is_none()), "{by_window:?}");
+}
+
+/// The sky coefficients know which window each bit of sky is seen through:
+/// a desk by the west end of the window wall sees most sky through the
+/// western panes, one by the east end through the eastern ones.
+#[test]
+fn sky_light_is_attributed_to_the_windows_it_comes_through() {
+    let scene = load(&sideroom());
+    let model = LightModel::precompute(scene.clone(), quick()).unwrap();
+    let sky = sky_at(&scene, &SkySpec::Uniform, "2026-03-21", "12:00");
+    let lighting = model.solve(&sky, None);
+    let by_window = model.sky_through_windows(&sky);
+    // Windows #0/#1 are the western panes (x ≈ 0.8 m), #4/#5 the eastern (x ≈ 3.2 m).
+    let through = |sensor: usize, windows: [u32; 2]| -> f64 {
+        by_window[sensor].iter().filter(|(w, _)| w.is_some_and(|w| windows.contains(&w))).map(|(_, lux)| lux).sum()
+    };
+    for (sensor, reading) in lighting.sensors.iter().enumerate() {
+        let sum: f64 = by_window[sensor].iter().map(|(_, lux)| lux).sum();
+        assert!((sum - reading.direct_sky).abs() <= 1e-9 * reading.direct_sky.max(1.0), "{}: {sum} vs {}", reading.name, reading.direct_sky);
+        assert!(by_window[sensor].iter().all(|(w, _)| w.is_some()), "{} sees sky without a window", reading.name);
+    }
+    let index = |name: &str| lighting.sensors.iter().position(|r| r.name == name).unwrap();
+    let (west, east) = (index("s00"), index("s03"));
+    assert!(through(west, [0, 1]) > 3.0 * through(west, [4, 5]), "{:?}", by_window[west]);
+    assert!(through(east, [4, 5]) > 3.0 * through(east, [0, 1]), "{:?}", by_window[east]);
 }
 
 #[test]

@@ -5,7 +5,7 @@
 use std::time::Duration;
 
 use glam::DVec3;
-use glam_bvh::Vec3A;
+use glam_bvh::{UVec2, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
@@ -57,6 +57,25 @@ impl Tracer {
                 patch: self.owner[self.bvh.primitive_indices[hit.primitive_id as usize] as usize],
                 distance: f64::from(hit.t),
             })
+    }
+
+    /// Every surface along a ray beyond `t_min`, in no particular order, until
+    /// `visit` returns false: one traversal for shadow rays through glass,
+    /// which stops at the first opaque surface.
+    pub fn each_hit(&self, origin: DVec3, direction: DVec3, t_min: f64, mut visit: impl FnMut(Hit) -> bool) {
+        let direction = direction + DVec3::ZERO;
+        let ray = Ray::new(to_bvh(origin), to_bvh(direction), t_min as f32, f32::INFINITY);
+        let mut state = self.bvh.new_traversal(ray.direction);
+        let mut node;
+        'traversal: {
+            obvhs::traverse!(self.bvh, node, state, node.intersect_ray(&ray, state.oct_inv4), {
+                let triangle = self.bvh.primitive_indices[state.primitive_id as usize] as usize;
+                let t = self.triangles[triangle].intersect(&ray);
+                if t < ray.tmax && !visit(Hit { patch: self.owner[triangle], distance: f64::from(t) }) {
+                    break 'traversal;
+                }
+            });
+        }
     }
 }
 

@@ -15,7 +15,7 @@ use crate::scene::Scene;
 
 const MAGIC: &[u8; 8] = b"HELIOLT\0";
 /// Bump when the model or its layout changes.
-const FORMAT: u32 = 2;
+const FORMAT: u32 = 3;
 
 /// What happened to the cache.
 #[derive(Debug, Clone, PartialEq, Eq)]

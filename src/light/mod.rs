@@ -103,12 +103,37 @@ const MIN_WEIGHT: f64 = 1e-4;
 /// Sensors closer than this to a surface behind them read as lifted this far.
 const SENSOR_LIFT: f64 = 0.01;
 
-/// Where a receiver's hemisphere light comes from: bins of the sky sphere and
-/// patch sides, each with its share (the shares of all rays sum to at most 1).
+/// Where a receiver's hemisphere light comes from: bins of the sky sphere,
+/// each through the window it was seen through (see [`SkyKey`]), and patch
+/// sides, each with its share (the shares of all rays sum to at most 1).
+/// Shares through glass carry the glass's transmittance.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Gather {
+    /// Packed [`SkyKey`]s with their shares, sorted by key.
     pub bins: Vec<(u32, f32)>,
     pub sides: Vec<(u32, f32)>,
+}
+
+/// A sky or ground bin as a receiver sees it: straight (no window between,
+/// `window: None`) or through the first window its ray crossed. Packed into
+/// one `u32` as `slot · bin_count + bin`, slot 0 for none and `k + 1` for
+/// window `k` of [`Scene::windows`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SkyKey {
+    pub window: Option<u32>,
+    /// Index into the sky sphere's bins ([`SkyPatches::sphere_bin`]).
+    pub bin: u32,
+}
+
+impl SkyKey {
+    fn pack(self, bin_count: u32) -> u32 {
+        self.window.map_or(0, |w| w + 1) * bin_count + self.bin
+    }
+
+    fn unpack(key: u32, bin_count: u32) -> Self {
+        let slot = key / bin_count;
+        Self { window: slot.checked_sub(1), bin: key % bin_count }
+    }
 }
 
 /// A ray that reached a diffuse patch side.
@@ -158,6 +183,8 @@ pub struct LightModel {
     pub bins: SkyPatches,
     tracer: Tracer,
     surfaces: Vec<Surface>,
+    /// Per scene surface: its index in [`Scene::windows`], if it is one.
+    window_of_surface: Vec<Option<u32>>,
     /// Per patch side (2 per patch; empty for glass and panels).
     side_gathers: Vec<Gather>,
     sensors: Vec<SensorGeometry>,
@@ -273,8 +300,13 @@ impl LightModel {
                 MaterialKind::Panel { .. } => Surface::PassThrough,
             })
             .collect();
+        let mut window_of_surface = vec![None; scene.surfaces.len()];
+        for (k, window) in scene.windows.iter().enumerate() {
+            window_of_surface[window.surface as usize] = Some(k as u32);
+        }
         Self {
             bins: SkyPatches::reinhart(settings.sky_subdivision),
+            window_of_surface,
             scene,
             settings,
             tracer,
@@ -307,7 +339,7 @@ impl LightModel {
             return None;
         }
         let sensors = (0..sensor_count).map(|_| SensorGeometry::read(&mut r)).collect::<Option<Vec<_>>>()?;
-        let bins = 2 * SkyPatches::reinhart(settings.sky_subdivision).len() as u32;
+        let bins = (scene.windows.len() as u32 + 1) * 2 * SkyPatches::reinhart(settings.sky_subdivision).len() as u32;
         let patch_sides = sides as u32;
         let fits = |g: &Gather| g.bins.iter().all(|b| b.0 < bins) && g.sides.iter().all(|s| s.0 < patch_sides);
         let hits_fit = |s: &SensorGeometry| s.hits.iter().all(|h| h.0 < patch_sides);
@@ -328,27 +360,35 @@ impl LightModel {
         self.scene.patches.patches[patch as usize].normal.as_dvec3()
     }
 
-    /// Follows a ray through glass, adding what it reaches to `bins`/`sides`.
-    fn follow(&self, origin: DVec3, dir: DVec3, weight: f64, depth: u32, bins: &mut Vec<(u32, f64)>, sides: &mut Vec<SideHit>) {
+    /// Bins of the sky sphere (sky above the horizon, ground below).
+    fn bin_count(&self) -> u32 {
+        2 * self.bins.len() as u32
+    }
+
+    /// Follows a ray through glass, adding what it reaches to `bins`/`sides`;
+    /// `window` is the first window it crossed.
+    #[allow(clippy::too_many_arguments)]
+    fn follow(&self, origin: DVec3, dir: DVec3, weight: f64, depth: u32, window: Option<u32>, bins: &mut Vec<(u32, f64)>, sides: &mut Vec<SideHit>) {
         match self.tracer.closest(origin, dir, 1e-6) {
-            None => bins.push((self.bins.sphere_bin(dir) as u32, weight)),
+            None => bins.push((SkyKey { window, bin: self.bins.sphere_bin(dir) as u32 }.pack(self.bin_count()), weight)),
             Some(hit) => {
                 let normal = self.patch_normal(hit.patch);
                 let cos = dir.dot(normal);
                 let point = origin + dir * hit.distance;
+                let crossed = window.or(self.window_of_surface[self.scene.patches.patches[hit.patch as usize].surface as usize]);
                 match self.surface_of_patch(hit.patch) {
                     Surface::Diffuse(_) => sides.push(SideHit { side: side_of(hit.patch, cos > 0.0), weight, point }),
                     Surface::PassThrough if depth < MAX_GLASS_DEPTH => {
-                        self.follow(point + dir * SURFACE_OFFSET, dir, weight, depth + 1, bins, sides)
+                        self.follow(point + dir * SURFACE_OFFSET, dir, weight, depth + 1, crossed, bins, sides)
                     }
                     Surface::Glass(glass) if depth < MAX_GLASS_DEPTH => {
                         let (t, r) = glass.at(cos);
                         if weight * t > MIN_WEIGHT {
-                            self.follow(point + dir * SURFACE_OFFSET, dir, weight * t, depth + 1, bins, sides);
+                            self.follow(point + dir * SURFACE_OFFSET, dir, weight * t, depth + 1, crossed, bins, sides);
                         }
                         if weight * r > MIN_WEIGHT {
                             let reflected = dir - 2.0 * cos * normal;
-                            self.follow(point + reflected * SURFACE_OFFSET, reflected, weight * r, depth + 1, bins, sides);
+                            self.follow(point + reflected * SURFACE_OFFSET, reflected, weight * r, depth + 1, window, bins, sides);
                         }
                     }
                     _ => {}
@@ -358,19 +398,31 @@ impl LightModel {
     }
 
     /// How much of the sun reaches `point` (through glass; 0 when blocked).
+    /// The product of the glass crossed does not depend on their order, so
+    /// one traversal visits them all and stops at the first opaque surface.
     fn sun_transmittance(&self, point: DVec3, sun: DVec3) -> f64 {
-        let mut origin = point;
         let mut transmittance = 1.0;
-        for _ in 0..=MAX_GLASS_DEPTH {
-            let Some(hit) = self.tracer.closest(origin, sun, 1e-6) else { return transmittance };
-            match self.surface_of_patch(hit.patch) {
-                Surface::Diffuse(_) => return 0.0,
-                Surface::Glass(glass) => transmittance *= glass.at(sun.dot(self.patch_normal(hit.patch))).0,
-                Surface::PassThrough => {}
+        // Glass surfaces crossed, by distance: a ray through the edge between
+        // two triangles of one surface meets it twice.
+        let mut crossed: Vec<(u32, f64)> = Vec::new();
+        self.tracer.each_hit(point, sun, 1e-6, |hit| {
+            let patch = &self.scene.patches.patches[hit.patch as usize];
+            match self.surfaces[patch.material as usize] {
+                Surface::Diffuse(_) => {
+                    transmittance = 0.0;
+                    false
+                }
+                Surface::Glass(glass) => {
+                    if !crossed.iter().any(|&(s, d)| s == patch.surface && (d - hit.distance).abs() < 1e-5) {
+                        crossed.push((patch.surface, hit.distance));
+                        transmittance *= glass.at(sun.dot(patch.normal.as_dvec3())).0;
+                    }
+                    true
+                }
+                Surface::PassThrough => true,
             }
-            origin += sun * (hit.distance + SURFACE_OFFSET);
-        }
-        0.0
+        });
+        transmittance
     }
 
     fn gather_patch_side(&self, side: usize) -> Gather {
@@ -386,7 +438,7 @@ impl LightModel {
         let (mut bins, mut sides) = (Vec::new(), Vec::new());
         for dir in directions {
             let point = sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET;
-            self.follow(point, dir, 1.0, 0, &mut bins, &mut sides);
+            self.follow(point, dir, 1.0, 0, None, &mut bins, &mut sides);
         }
         Gather::from_raw(bins, &sides, self.settings.rays_per_patch)
     }
@@ -417,7 +469,7 @@ impl LightModel {
         let (mut bins, mut sides) = (Vec::new(), Vec::new());
         for &point in &points {
             for dir in cosine_directions(normal, per_point, &mut rng) {
-                self.follow(point, dir, 1.0, 0, &mut bins, &mut sides);
+                self.follow(point, dir, 1.0, 0, None, &mut bins, &mut sides);
             }
         }
         let rays = per_point * points.len();
@@ -440,7 +492,8 @@ impl LightModel {
         let mut bin_radiance = Vec::with_capacity(2 * self.bins.len());
         self.bins.integrate_sphere_into(sky, &mut bin_radiance);
         let patches = &self.scene.patches.patches;
-        let sky_irradiance = |g: &Gather| PI * g.bins.iter().map(|&(b, w)| f64::from(w) * bin_radiance[b as usize]).sum::<f64>();
+        let bin_count = self.bin_count();
+        let sky_irradiance = |g: &Gather| PI * g.bins.iter().map(|&(k, w)| f64::from(w) * bin_radiance[(k % bin_count) as usize]).sum::<f64>();
         let sun = sky.sun.filter(|s| s.direction.z > 0.0);
         let direct: Vec<Channels> = par_map(self.settings.threads, patches.len() * 2, |side| {
             let gather = &self.side_gathers[side];
@@ -644,6 +697,29 @@ fn place_sensor(tracer: &Tracer, sensor: &Sensor, n: usize) -> Vec<DVec3> {
 }
 
 impl LightModel {
+    /// Each sensor's direct sky and ground light in lux, split by where it
+    /// comes from: `(None, lux)` straight from outside, `(Some(k), lux)`
+    /// through window `k` of [`Scene::windows`]. Sums to `direct_sky`.
+    pub fn sky_through_windows(&self, sky: &Sky) -> Vec<Vec<(Option<u32>, f64)>> {
+        let mut bin_radiance = Vec::with_capacity(self.bin_count() as usize);
+        self.bins.integrate_sphere_into(sky, &mut bin_radiance);
+        self.sensors
+            .iter()
+            .map(|geometry| {
+                let mut by_window: Vec<(Option<u32>, f64)> = Vec::new();
+                for &(k, w) in &geometry.gather.bins {
+                    let key = SkyKey::unpack(k, self.bin_count());
+                    let lux = PI * f64::from(w) * bin_radiance[key.bin as usize] * LUMINOUS_EFFICACY;
+                    match by_window.last_mut() {
+                        Some(last) if last.0 == key.window => last.1 += lux,
+                        _ => by_window.push((key.window, lux)),
+                    }
+                }
+                by_window
+            })
+            .collect()
+    }
+
     /// Sensors that seem to sit inside a solid: every ray from them meets a
     /// surface from its back, within a few metres. They still read what
     /// reaches them; the caller warns.
