@@ -9,7 +9,9 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::ecs::PanelRegistry;
-use crate::scene::{self, MaterialKind, Scene};
+use crate::render::offscreen::OffscreenRequest;
+use crate::render::{RenderMode, RenderSettings};
+use crate::scene::{self, DEFAULT_FOV, MaterialKind, Scene, Viewpoint};
 use crate::light::{LightSettings, Lighting, cache};
 use crate::site::Site;
 use crate::sky::{Sky, SkyInputs, SkySpec};
@@ -49,9 +51,66 @@ pub enum Command {
     /// Write a Radiance model of the scene, sky and sensors, with a run.sh that computes the sensors in Radiance
     #[command(name = "export-radiance", allow_negative_numbers = true)]
     ExportRadiance(ExportArgs),
+    /// Draw a view of the scene lit by the sun and sky to a PNG, headless (any GPU or a software Vulkan driver)
+    #[command(allow_negative_numbers = true)]
+    Render(RenderArgs),
     /// Sun position (NREL SPA) for a site and a local standard time, or the day's sunrise, noon and sunset
     #[command(allow_negative_numbers = true)]
     Sun(SunArgs),
+}
+
+#[derive(clap::Args, Debug)]
+pub struct RenderArgs {
+    /// Scene file (TOML)
+    pub scene: PathBuf,
+    /// Local date, YYYY-MM-DD
+    #[arg(long, value_parser = Date::parse)]
+    pub date: Date,
+    /// Local standard time, HH:MM
+    #[arg(long, value_parser = TimeOfDay::parse)]
+    pub time: TimeOfDay,
+    #[command(flatten)]
+    pub sky: SkyArgs,
+    /// PNG file to write
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Also write the physical image (radiance, W/sr/m² per channel; 179 lm/W) as a Radiance .hdr picture
+    #[arg(long, value_name = "FILE")]
+    pub hdr: Option<PathBuf>,
+    /// A viewpoint from the scene's [[cameras]]
+    #[arg(long, conflicts_with_all = ["eye", "target"])]
+    pub camera: Option<String>,
+    /// Eye position, model metres: X,Y,Z
+    #[arg(long, value_parser = parse_point, requires = "target")]
+    pub eye: Option<glam::Vec3>,
+    /// Point looked at: X,Y,Z
+    #[arg(long, value_parser = parse_point, requires = "eye")]
+    pub target: Option<glam::Vec3>,
+    /// Vertical field of view, degrees
+    #[arg(long, value_name = "DEG", value_parser = in_range(1.0, 170.0))]
+    pub fov: Option<f64>,
+    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    pub width: u32,
+    #[arg(long, default_value_t = 800, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    pub height: u32,
+    /// Exposure value (EV100); automatic from the scene's light when absent
+    #[arg(long, value_name = "EV", value_parser = in_range(-10.0, 30.0))]
+    pub exposure: Option<f64>,
+    /// full, sun, sky, indirect or falsecolor
+    #[arg(long, default_value = "full", value_parser = parse_mode)]
+    pub mode: RenderMode,
+}
+
+fn parse_point(text: &str) -> Result<glam::Vec3, String> {
+    let values: Vec<f32> = text.split(',').map(|v| v.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|_| format!("'{text}' is not X,Y,Z"))?;
+    match values[..] {
+        [x, y, z] if values.iter().all(|v| v.is_finite()) => Ok(glam::Vec3::new(x, y, z)),
+        _ => Err(format!("'{text}' is not three finite numbers X,Y,Z")),
+    }
+}
+
+fn parse_mode(text: &str) -> Result<RenderMode, String> {
+    RenderMode::parse(text).ok_or_else(|| format!("'{text}' is not one of {}", RenderMode::NAMES.join(", ")))
 }
 
 #[derive(clap::Args, Debug)]
@@ -236,6 +295,13 @@ pub fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         },
+        Some(Command::Render(args)) => match render(&args) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(error) => {
+                eprintln!("error: {error}");
+                ExitCode::FAILURE
+            }
+        },
         Some(Command::Sun(args)) => {
             print!("{}", sun_report(&args));
             ExitCode::SUCCESS
@@ -279,6 +345,40 @@ pub fn export_radiance(args: &ExportArgs) -> Result<(), String> {
         when.date, when.time, args.sky.sky, position.altitude, position.azimuth
     );
     crate::radiance::export(&scene, &sky, &case, &args.out)
+}
+
+/// The `render` command.
+pub fn render(args: &RenderArgs) -> Result<(), String> {
+    let sky = args.sky.spec()?;
+    let scene = load_for_command(&args.scene)?;
+    let mut view = match &args.camera {
+        Some(name) => Some(scene.viewpoints.iter().find(|v| &v.name == name).cloned().ok_or_else(|| {
+            let known: Vec<&str> = scene.viewpoints.iter().map(|v| v.name.as_str()).collect();
+            format!("--camera {name}: {} has no such camera (it has: {})", args.scene.display(), if known.is_empty() { "none".into() } else { known.join(", ") })
+        })?),
+        None => args.eye.zip(args.target).map(|(eye, target)| Viewpoint { name: "command line".into(), eye, target, fov: DEFAULT_FOV }),
+    };
+    if view.as_ref().is_some_and(|v| (v.eye - v.target).length() < 1e-6) {
+        return Err("--eye and --target are the same point".into());
+    }
+    if let Some(fov) = args.fov {
+        let base = view.unwrap_or_else(|| crate::render::initial_view(&scene));
+        view = Some(Viewpoint { fov: fov as f32, ..base });
+    }
+    let image = crate::render::offscreen::render(OffscreenRequest {
+        scene: args.scene.clone(),
+        view,
+        width: args.width,
+        height: args.height,
+        when: Some(LocalDateTime { date: args.date, time: args.time }),
+        sky: Some(sky),
+        settings: RenderSettings { mode: args.mode, exposure: args.exposure.map(|e| e as f32), ..Default::default() },
+    })?;
+    image.save_png(&args.out)?;
+    match &args.hdr {
+        Some(path) => image.save_hdr(path),
+        None => Ok(()),
+    }
 }
 
 /// The `sensors` command: one precomputation, then every date × time.

@@ -9,7 +9,16 @@ use heliodon::ecs::{
     ActiveScene, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, SceneSensor, SceneSpawned, SceneSurface,
     SceneWindow, Site,
 };
+use std::sync::Arc;
+
+use glam::DVec3;
+use heliodon::light::LightModel;
 use heliodon::render::offscreen::{self, OffscreenRequest};
+use heliodon::render::{RenderMode, RenderSettings, initial_view};
+use heliodon::scene::{MaterialKind, PanelNames, Scene, Viewpoint, load_scene};
+use heliodon::sky::{Sky, SkySpec};
+use heliodon::sun::solar_position;
+use heliodon::time::{Date, LocalDateTime, TimeOfDay};
 
 fn headless_app() -> App {
     let mut app = App::new();
@@ -111,7 +120,7 @@ fn a_failed_load_reports_one_line_and_keeps_the_previous_scene() {
 
 #[test]
 fn render_smoke_test_draws_the_model() {
-    let request = OffscreenRequest { scene: heliodon::bundled_scene("test_room"), view: None, width: 320, height: 240 };
+    let request = OffscreenRequest { scene: heliodon::bundled_scene("test_room"), view: None, width: 320, height: 240, when: None, sky: None, settings: Default::default() };
     let image = offscreen::render(request).expect("render");
     let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render_smoke_test_room.png");
     image.save_png(&out).unwrap();
@@ -225,5 +234,103 @@ fn relights_run_as_tasks_and_the_last_change_wins() {
         assert_eq!(a.name, b.name);
         assert!((a.total - b.total).abs() <= 1e-3 * b.total.max(1.0), "{a:?} vs {b:?}");
         assert_eq!(a.direct_sun, b.direct_sun);
+    }
+}
+
+/// Pixel centres' rays of a perspective camera as Bevy draws it (vertical
+/// field of view, the model's z up), row by row from the top.
+fn camera_rays(view: &Viewpoint, width: u32, height: u32) -> Vec<DVec3> {
+    let forward = (view.target - view.eye).normalize().as_dvec3();
+    let right = forward.cross(DVec3::Z).normalize();
+    let up = right.cross(forward);
+    let tan = (f64::from(view.fov).to_radians() / 2.0).tan();
+    let aspect = f64::from(width) / f64::from(height);
+    (0..height)
+        .flat_map(|j| (0..width).map(move |i| (i, j)))
+        .map(|(i, j)| {
+            let x = (2.0 * (f64::from(i) + 0.5) / f64::from(width) - 1.0) * tan * aspect;
+            let y = (1.0 - 2.0 * (f64::from(j) + 0.5) / f64::from(height)) * tan;
+            (forward + right * x + up * y).normalize()
+        })
+        .collect()
+}
+
+/// The direct-sun image (mode `sun`) against a CPU ray tracer: each pixel's
+/// ray finds its surface, then a shadow ray from there toward the sun goes
+/// through glass (Radiance's transmittance) or meets an opaque surface.
+/// Pixels whose ray meets glass or nothing are not compared.
+#[test]
+fn direct_sun_images_agree_with_a_ray_traced_reference() {
+    let (width, height) = (320u32, 200u32);
+    let out_dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let mut report = Vec::new();
+    for name in heliodon::BUNDLED_SCENES {
+        let path = heliodon::bundled_scene(name);
+        let scene = Arc::new(load_scene(&path, &PanelNames::new()).unwrap().scene);
+        let model = LightModel::unlit(scene.clone());
+        let overview = Viewpoint { name: "overview".into(), ..initial_view(&Scene { viewpoints: Vec::new(), ..(*scene).clone() }) };
+        let cases = [(scene.viewpoints[0].clone(), "2026-03-21", "10:00"), (scene.viewpoints[0].clone(), "2026-11-10", "14:30"), (overview, "2026-12-21", "12:00")];
+        for (view, date, time) in cases {
+            let when = LocalDateTime { date: Date::parse(date).unwrap(), time: TimeOfDay::parse(time).unwrap() };
+            let sun = solar_position(&scene.site, &when);
+            let sky = Sky::new(&SkySpec::Clear { turbidity: 2.45 }, sun.altitude, sun.azimuth, scene.site.ground_reflectance, when.date.day_of_year()).unwrap();
+            let sun = sky.sun.expect("the sun is up in every case");
+            let request = OffscreenRequest {
+                scene: path.clone(),
+                view: Some(view.clone()),
+                width,
+                height,
+                when: Some(when),
+                sky: Some(SkySpec::Clear { turbidity: 2.45 }),
+                settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
+            };
+            let image = offscreen::render(request).expect("render");
+            let file = out_dir.join(format!("sun_{name}_{}_{}.png", view.name.replace(' ', "_"), time.replace(':', "")));
+            image.save_png(&file).unwrap();
+            let (mut compared, mut agree, mut lit, mut within) = (0usize, 0usize, 0usize, 0usize);
+            let mut worst: f64 = 0.0;
+            // Disagreements for a person to look at: red where only the
+            // reference is lit, green where only the image is.
+            let mut disagreement = image::RgbImage::new(width, height);
+            for (k, (ray, gpu)) in camera_rays(&view, width, height).into_iter().zip(&image.physical).enumerate() {
+                let eye = view.eye.as_dvec3();
+                let Some((patch, distance)) = model.trace(eye, ray) else { continue };
+                let patch = &scene.patches.patches[patch as usize];
+                let MaterialKind::Diffuse { reflectance } = &scene.materials[patch.material as usize].kind else { continue };
+                let mut normal = patch.normal.as_dvec3();
+                if normal.dot(ray) > 0.0 {
+                    normal = -normal;
+                }
+                let irradiance = model.sun_irradiance(eye + ray * distance, normal, &sun);
+                let expected = f64::from(reflectance.0[1]) / std::f64::consts::PI * irradiance * 179.0;
+                let got = f64::from(gpu[1]);
+                compared += 1;
+                let (cpu_lit, gpu_lit) = (expected > 1.0, got > 1.0);
+                agree += usize::from(cpu_lit == gpu_lit);
+                let shade = if cpu_lit == gpu_lit { [40 + 80 * u8::from(cpu_lit); 3] } else if cpu_lit { [255, 0, 0] } else { [0, 255, 0] };
+                disagreement.put_pixel(k as u32 % width, k as u32 / width, image::Rgb(shade));
+                if cpu_lit && gpu_lit {
+                    lit += 1;
+                    let error = (got / expected - 1.0).abs();
+                    within += usize::from(error <= 0.02);
+                    worst = worst.max(error);
+                }
+            }
+            disagreement.save(file.with_extension("diff.png")).unwrap();
+            let agreement = agree as f64 / compared as f64;
+            let within = within as f64 / lit.max(1) as f64;
+            report.push(format!(
+                "{name} {} {date} {time}: {compared} pixels, lit/unlit agree {:.2}%, {lit} lit, {:.2}% within 2% (worst {:.1}%) -> {}",
+                view.name,
+                100.0 * agreement,
+                100.0 * within,
+                100.0 * worst,
+                file.display()
+            ));
+            println!("{}", report.last().unwrap());
+            assert!(compared > (width * height / 10) as usize, "{}", report.last().unwrap());
+            assert!(lit > 200, "too few sunlit pixels to compare: {}", report.last().unwrap());
+            assert!(agreement >= 0.99 && within >= 0.99, "{}", report.last().unwrap());
+        }
     }
 }

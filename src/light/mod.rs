@@ -288,6 +288,28 @@ impl LightModel {
         Ok(model)
     }
 
+    /// The model with its tracer and materials but nothing gathered: enough
+    /// for ray queries ([`Self::trace`], [`Self::sun_irradiance`]), not for
+    /// lighting.
+    pub fn unlit(scene: Arc<Scene>) -> Self {
+        Self::empty(scene, LightSettings::default())
+    }
+
+    /// The first patch a ray meets and its distance.
+    pub fn trace(&self, origin: DVec3, direction: DVec3) -> Option<(u32, f64)> {
+        self.tracer.closest(origin, direction, 1e-6).map(|hit| (hit.patch, hit.distance))
+    }
+
+    /// Direct sun irradiance (W/m²) at `point` on a surface whose side
+    /// facing the light of interest has `normal`: shadow ray through glass.
+    pub fn sun_irradiance(&self, point: DVec3, normal: DVec3, sun: &crate::sky::SunSource) -> f64 {
+        let cos = normal.dot(sun.direction);
+        if cos <= 0.0 || sun.direction.z <= 0.0 {
+            return 0.0;
+        }
+        sun.normal_irradiance() * cos * self.sun_transmittance(point + normal * SURFACE_OFFSET, sun.direction)
+    }
+
     /// The model with its tracer and materials but nothing gathered yet.
     fn empty(scene: Arc<Scene>, settings: LightSettings) -> Self {
         let tracer = Tracer::new(&scene.patches);

@@ -1,13 +1,18 @@
 //! Offscreen rendering: a headless app (no window, no event loop) that opens a
-//! scene, draws it from a viewpoint into an image and hands back the pixels.
-//! Works on any GPU or on Mesa's software Vulkan driver.
+//! scene, lets the light engine converge, draws it from a viewpoint with the
+//! hybrid renderer and hands back two images of the same frame: the picture
+//! (exposed, tone-mapped, 8-bit sRGB) and the physical values (linear RGB in
+//! cd/m², no exposure, no tone mapping). Works on any GPU or on Mesa's
+//! software Vulkan driver.
 
-use std::path::PathBuf;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use bevy::app::ScheduleRunnerPlugin;
-use bevy::camera::RenderTarget;
+use bevy::camera::{Exposure, RenderTarget};
+use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::log::LogPlugin;
 use bevy::prelude::*;
 use bevy::render::RenderPlugin;
@@ -16,9 +21,15 @@ use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy::window::ExitCondition;
 use bevy::winit::WinitPlugin;
 
-use super::{HeliodonRenderPlugin, initial_view};
-use crate::ecs::{ActiveScene, HeliodonPlugins, OpenScene, SceneLoadFailed, SceneSpawned};
+use super::sun_pass::SunPassInput;
+use super::{HeliodonRenderPlugin, PhysicalUnits, RenderMode, RenderSettings, hybrid_camera, initial_view};
+use crate::ecs::{
+    ActiveScene, HeliodonPlugins, LightingFailed, LightingPlugin, LightingState, OpenScene, SceneLoadFailed, SceneSpawned, SkyChoice,
+    SolarTime, SunSky,
+};
 use crate::scene::Viewpoint;
+use crate::sky::{LUMINOUS_EFFICACY, SkySpec};
+use crate::time::LocalDateTime;
 
 /// What to draw.
 #[derive(Debug, Clone)]
@@ -28,120 +39,217 @@ pub struct OffscreenRequest {
     pub view: Option<Viewpoint>,
     pub width: u32,
     pub height: u32,
+    /// Local time at the site; `None`: the app's default.
+    pub when: Option<LocalDateTime>,
+    /// `None`: the app's default sky.
+    pub sky: Option<SkySpec>,
+    pub settings: RenderSettings,
 }
 
-/// An 8-bit sRGB image, row-major RGBA.
+/// One rendered frame.
 #[derive(Debug, Clone)]
 pub struct RenderedImage {
     pub width: u32,
     pub height: u32,
+    /// The picture: 8-bit sRGB, row-major RGBA.
     pub rgba: Vec<u8>,
+    /// The physical image: linear RGB luminance per channel, cd/m², row-major.
+    pub physical: Vec<[f32; 3]>,
 }
 
 impl RenderedImage {
-    pub fn save_png(&self, path: &std::path::Path) -> Result<(), String> {
+    pub fn save_png(&self, path: &Path) -> Result<(), String> {
         let buffer = image::RgbaImage::from_raw(self.width, self.height, self.rgba.clone())
             .ok_or("image size does not match its pixels")?;
         buffer.save(path).map_err(|e| format!("{}: cannot write image: {e}", path.display()))
     }
+
+    /// Writes the physical image as a Radiance picture (RGBE): radiance in
+    /// W/sr/m² per channel, so Radiance's tools (ximage, pcond, pvalue)
+    /// read the same luminance (179 lm/W).
+    pub fn save_hdr(&self, path: &Path) -> Result<(), String> {
+        let mut out = Vec::with_capacity(self.physical.len() * 4 + 128);
+        let _ = write!(out, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\nEXPOSURE=1\nSOFTWARE=heliodon\n\n-Y {} +X {}\n", self.height, self.width);
+        for pixel in &self.physical {
+            out.extend(rgbe(pixel.map(|c| c / LUMINOUS_EFFICACY as f32)));
+        }
+        std::fs::write(path, out).map_err(|e| format!("{}: cannot write image: {e}", path.display()))
+    }
 }
 
-/// Frames to draw before capturing: pipelines queued in one frame are usable
-/// only in a later one.
+/// Radiance's shared-exponent encoding of one pixel.
+fn rgbe(rgb: [f32; 3]) -> [u8; 4] {
+    let max = rgb.iter().copied().fold(0.0f32, f32::max);
+    if max.is_nan() || max <= 1e-32 {
+        return [0; 4];
+    }
+    let exponent = max.log2().floor() as i32 + 1;
+    let scale = 256.0 / 2f32.powi(exponent);
+    let [r, g, b] = rgb.map(|c| (c.max(0.0) * scale).min(255.0) as u8);
+    [r, g, b, (exponent + 128) as u8]
+}
+
+/// Frames to draw once the light is ready before capturing: pipelines
+/// queued in one frame are usable only in a later one, and new vertex
+/// values reach the GPU a frame later.
 const WARM_UP_FRAMES: u32 = 5;
+
+/// Exposure value at which the view's exposure factor is 1 (Bevy: 2^-EV / 1.2).
+fn unit_exposure() -> Exposure {
+    Exposure { ev100: (1.0f32 / 1.2).log2() }
+}
 
 #[derive(Resource)]
 struct Job {
     request: OffscreenRequest,
-    target: Option<Handle<Image>>,
+    targets: Option<[Handle<Image>; 2]>,
     frames_drawn: u32,
     capture_requested: bool,
-    result: Arc<Mutex<Option<Result<RenderedImage, String>>>>,
+    picture: Arc<Mutex<Option<Vec<u8>>>>,
+    physical: Arc<Mutex<Option<Vec<[f32; 3]>>>>,
+    failure: Option<String>,
 }
 
-/// Renders one image of a scene. Errors are one line.
+/// Renders one frame of a scene. Errors are one line.
 pub fn render(request: OffscreenRequest) -> Result<RenderedImage, String> {
-    let result = Arc::new(Mutex::new(None));
-    App::new()
-        .add_plugins(
-            DefaultPlugins
-                .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
-                .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() })
-                .set(crate::asset_plugin())
-                .disable::<WinitPlugin>()
-                .disable::<LogPlugin>(),
-        )
-        .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::ZERO))
-        .add_plugins((HeliodonPlugins, HeliodonRenderPlugin))
+    let picture = Arc::new(Mutex::new(None));
+    let physical = Arc::new(Mutex::new(None));
+    let mut app = App::new();
+    app.add_plugins(
+        DefaultPlugins
+            .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
+            .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() })
+            .set(crate::asset_plugin())
+            .disable::<WinitPlugin>()
+            .disable::<LogPlugin>(),
+    )
+    .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::ZERO));
+    // Direct sun alone needs no light engine: skip its precomputation.
+    if request.settings.mode == RenderMode::Sun {
+        app.add_plugins(HeliodonPlugins.build().disable::<LightingPlugin>());
+    } else {
+        app.add_plugins(HeliodonPlugins);
+    }
+    app.add_plugins(HeliodonRenderPlugin)
+        .insert_resource(request.settings)
         .insert_resource(Job {
             request: request.clone(),
-            target: None,
+            targets: None,
             frames_drawn: 0,
             capture_requested: false,
-            result: result.clone(),
+            picture: picture.clone(),
+            physical: physical.clone(),
+            failure: None,
         })
-        .add_systems(Startup, |job: Res<Job>, mut open: MessageWriter<OpenScene>| {
+        .add_systems(Startup, |job: Res<Job>, mut open: MessageWriter<OpenScene>, mut time: ResMut<SolarTime>, mut sky: ResMut<SkyChoice>| {
             open.write(OpenScene(job.request.scene.clone()));
+            if let Some(when) = job.request.when {
+                time.0 = when;
+            }
+            if let Some(spec) = job.request.sky.clone() {
+                sky.0 = spec;
+            }
         })
-        .add_systems(Update, (spawn_camera, capture, finish).chain().after(crate::ecs::HeliodonSystems::SpawnScene))
+        .add_systems(Update, (spawn_cameras, capture, finish).chain().after(crate::ecs::HeliodonSystems::SpawnScene))
         .run();
-    let outcome = result.lock().expect("offscreen result lock").take();
-    outcome.unwrap_or_else(|| Err("the renderer stopped before producing an image".into()))
+    let job = app.world_mut().remove_resource::<Job>();
+    if let Some(failure) = job.and_then(|j| j.failure) {
+        return Err(failure);
+    }
+    let rgba = picture.lock().expect("offscreen picture lock").take();
+    let physical = physical.lock().expect("offscreen physical lock").take();
+    let pixels = (request.width * request.height) as usize;
+    match (rgba, physical) {
+        (Some(rgba), Some(physical)) if rgba.len() == 4 * pixels && physical.len() == pixels => {
+            Ok(RenderedImage { width: request.width, height: request.height, rgba, physical })
+        }
+        (Some(_), Some(_)) => Err("cannot read back the rendered image: unexpected size or format".into()),
+        _ => Err("the renderer stopped before producing an image".into()),
+    }
 }
 
-fn spawn_camera(
+/// The picture's camera and, beside it, one with the same view writing
+/// physical values into a float image.
+fn spawn_cameras(
     mut commands: Commands,
     mut spawned: MessageReader<SceneSpawned>,
     mut failed: MessageReader<SceneLoadFailed>,
+    mut light_failed: Option<MessageReader<LightingFailed>>,
     active: Res<ActiveScene>,
     mut job: ResMut<Job>,
     mut images: ResMut<Assets<Image>>,
 ) {
-    if let Some(failure) = failed.read().last() {
-        *job.result.lock().expect("offscreen result lock") = Some(Err(failure.message.clone()));
+    let lighting_failure = light_failed.as_mut().and_then(|m| m.read().last().map(|f| f.message.clone()));
+    if let Some(message) = failed.read().last().map(|f| f.message.clone()).or(lighting_failure) {
+        job.failure = Some(message);
     }
     if spawned.read().last().is_none() {
         return;
     }
     let Some(scene) = &active.scene else { return };
     let view = job.request.view.clone().unwrap_or_else(|| initial_view(scene));
-    let target = images.add(Image::new_target_texture(
-        job.request.width,
-        job.request.height,
-        TextureFormat::Rgba8UnormSrgb,
-        None,
-    ));
-    commands.spawn((
-        Camera3d::default(),
-        RenderTarget::Image(target.clone().into()),
+    let (width, height) = (job.request.width, job.request.height);
+    let picture = images.add(Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None));
+    let physical = images.add(Image::new_target_texture(width, height, TextureFormat::Rgba32Float, None));
+    let placement = (
         Projection::Perspective(PerspectiveProjection { fov: view.fov.to_radians(), ..default() }),
         Transform::from_translation(view.eye).looking_at(view.target, Vec3::Z),
-    ));
-    job.target = Some(target);
+    );
+    commands.spawn((hybrid_camera(), RenderTarget::Image(picture.clone().into()), placement.clone()));
+    commands
+        .spawn((hybrid_camera(), Camera { order: 1, ..default() }, PhysicalUnits, RenderTarget::Image(physical.clone().into()), placement))
+        .insert((Tonemapping::None, unit_exposure()));
+    job.targets = Some([picture, physical]);
 }
 
-fn capture(mut commands: Commands, mut job: ResMut<Job>) {
-    let Some(target) = job.target.clone() else { return };
+/// Whether what the mode shows has arrived: the converged light, or for
+/// direct sun alone, the sun pass's frame.
+fn light_ready(mode: RenderMode, lighting: Option<&LightingState>, sun_pass: &SunPassInput, sun_sky: Option<&SunSky>) -> bool {
+    match mode {
+        RenderMode::Sun => sun_sky.is_some() && (sun_pass.0.is_some() || sun_sky.is_some_and(|s| s.sky.sun.is_none_or(|sun| sun.direction.z <= 0.0))),
+        _ => lighting.is_some_and(|l| l.converged),
+    }
+}
+
+fn capture(
+    mut commands: Commands,
+    mut job: ResMut<Job>,
+    lighting: Option<Res<LightingState>>,
+    sun_pass: Res<SunPassInput>,
+    sun_sky: Option<Res<SunSky>>,
+) {
+    let Some([picture, physical]) = job.targets.clone() else { return };
+    if !light_ready(job.request.settings.mode, lighting.as_deref(), &sun_pass, sun_sky.as_deref()) {
+        job.frames_drawn = 0;
+        return;
+    }
     job.frames_drawn += 1;
     if job.frames_drawn < WARM_UP_FRAMES || job.capture_requested {
         return;
     }
     job.capture_requested = true;
-    let result = job.result.clone();
-    commands.spawn(Screenshot::image(target)).observe(move |captured: On<ScreenshotCaptured>| {
-        let image = match captured.image.clone().try_into_dynamic() {
-            Ok(dynamic) => {
-                let rgba = dynamic.to_rgba8();
-                Ok(RenderedImage { width: rgba.width(), height: rgba.height(), rgba: rgba.into_raw() })
-            }
-            Err(error) => Err(format!("cannot read back the rendered image: {error}")),
-        };
-        *result.lock().expect("offscreen result lock") = Some(image);
+    let out = job.picture.clone();
+    commands.spawn(Screenshot::image(picture)).observe(move |captured: On<ScreenshotCaptured>| {
+        let rgba = captured.image.clone().try_into_dynamic().map(|d| d.to_rgba8().into_raw()).unwrap_or_default();
+        *out.lock().expect("offscreen picture lock") = Some(rgba);
+    });
+    let out = job.physical.clone();
+    commands.spawn(Screenshot::image(physical)).observe(move |captured: On<ScreenshotCaptured>| {
+        let pixels = captured
+            .image
+            .data
+            .as_deref()
+            .unwrap_or_default()
+            .chunks_exact(16)
+            .map(|p| [0, 4, 8].map(|o| f32::from_le_bytes([p[o], p[o + 1], p[o + 2], p[o + 3]])))
+            .collect();
+        *out.lock().expect("offscreen physical lock") = Some(pixels);
     });
 }
 
 fn finish(job: Res<Job>, mut exit: MessageWriter<AppExit>) {
-    if job.result.lock().expect("offscreen result lock").is_some() {
+    let done = job.picture.lock().expect("offscreen picture lock").is_some() && job.physical.lock().expect("offscreen physical lock").is_some();
+    if done || job.failure.is_some() {
         exit.write(AppExit::Success);
     }
 }

@@ -24,7 +24,7 @@ impl Plugin for ViewerPlugin {
             open.write(OpenScene(scene.clone()));
         })
         .add_systems(Startup, |mut commands: Commands| {
-            commands.spawn((Camera3d::default(), CadCamera::looking(Vec3::new(-8.0, -10.0, 8.0), Vec3::ZERO)));
+            commands.spawn((crate::render::hybrid_camera(), CadCamera::looking(Vec3::new(-8.0, -10.0, 8.0), Vec3::ZERO)));
         })
         .add_systems(
             Update,

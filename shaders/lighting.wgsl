@@ -1,0 +1,49 @@
+// heliodon's surface material: the light engine's sky and interreflected
+// light per patch, interpolated at the vertices of each surface (vertex
+// colour, in cd/m²), scaled by the camera's exposure; Bevy's tone mapping
+// follows. Direct sun is added per pixel by the sun pass (sun_pass.wgsl).
+// In false-colour mode the vertex colour's red channel holds illuminance in
+// lux and is mapped to a colour scale here, per pixel.
+
+#import bevy_pbr::forward_io::VertexOutput
+#import bevy_pbr::mesh_view_bindings::view
+
+struct LightingMaterial {
+    // Glass and panels: a display colour with coverage in alpha.
+    tint: vec4<f32>,
+    // 0: luminance (cd/m², exposed); 1: false colour of illuminance.
+    mode: u32,
+    // Illuminance at the top of the false-colour scale, lux.
+    scale_max_lux: f32,
+}
+
+@group(#{MATERIAL_BIND_GROUP}) @binding(0) var<uniform> material: LightingMaterial;
+
+// The false-colour scale: logarithmic over three decades below the top,
+// blue, cyan, green, yellow, red, white.
+fn false_colour(lux: f32, top: f32) -> vec3<f32> {
+    let t = clamp(log2(max(lux, 1e-6) / top) / log2(1000.0) + 1.0, 0.0, 1.0);
+    let stops = array<vec3<f32>, 6>(
+        vec3(0.02, 0.02, 0.35), vec3(0.0, 0.45, 0.9), vec3(0.05, 0.75, 0.25),
+        vec3(0.95, 0.9, 0.1), vec3(0.9, 0.15, 0.05), vec3(1.0, 1.0, 1.0),
+    );
+    let x = t * 5.0;
+    let i = min(u32(floor(x)), 4u);
+    return mix(stops[i], stops[i + 1u], x - f32(i));
+}
+
+@fragment
+fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
+#ifdef VERTEX_COLORS
+    let value = in.color.rgb;
+#else
+    let value = vec3(0.0);
+#endif
+    if material.tint.a < 1.0 {
+        return material.tint;
+    }
+    if material.mode == 1u {
+        return vec4(false_colour(value.r, material.scale_max_lux), 1.0);
+    }
+    return vec4(value * view.exposure, 1.0);
+}

@@ -1,0 +1,288 @@
+//! [`SurfaceLightingPlugin`]: the model's surfaces drawn with the light
+//! engine's per-patch sky and interreflected light ([`LightingMaterial`],
+//! shaders/lighting.wgsl). Each material gets one mesh holding both sides of
+//! its surfaces (a wall lit on one side is dark on the other); vertex values
+//! average the patches of one surface and side that meet there, so light is
+//! smooth across patches and never bleeds over a crease. Under the patch
+//! meshes lies the model's own (watertight) triangles, pushed back in depth
+//! and shaded with each surface's mean: where patch clipping leaves
+//! T-junctions between surfaces, a crack shows that instead of the sky.
+
+use std::collections::HashMap;
+use std::f64::consts::PI;
+
+use bevy::asset::RenderAssetUsages;
+use bevy::mesh::PrimitiveTopology;
+use bevy::prelude::*;
+use bevy::render::render_resource::{AsBindGroup, ShaderType};
+use bevy::shader::ShaderRef;
+
+use super::{RenderMode, RenderSettings};
+use crate::ecs::{ActiveScene, HeliodonSystems, LightingState, SceneSpawned};
+use crate::light::{Channels, side_of};
+use crate::scene::{MaterialKind, Scene};
+use crate::sky::LUMINOUS_EFFICACY;
+
+pub struct SurfaceLightingPlugin;
+
+impl Plugin for SurfaceLightingPlugin {
+    fn build(&self, app: &mut App) {
+        let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
+        let _ = shaders.insert(LIGHTING_SHADER.id(), Shader::from_wgsl(include_str!("../../shaders/lighting.wgsl"), "shaders/lighting.wgsl"));
+        app.add_plugins(MaterialPlugin::<LightingMaterial>::default()).add_systems(
+            Update,
+            (spawn_surface_meshes, update_surface_values).chain().after(HeliodonSystems::Lighting),
+        );
+    }
+}
+
+const LIGHTING_SHADER: Handle<Shader> = bevy::asset::uuid_handle!("3c9a1e52-7d4b-4f60-9e2a-5b8c7d6e1f04");
+
+/// Surfaces as the engine lights them; see shaders/lighting.wgsl.
+#[derive(Asset, TypePath, AsBindGroup, Debug, Clone)]
+#[uniform(0, LightingMaterialUniform)]
+#[bind_group_data(LightingMaterialKey)]
+pub struct LightingMaterial {
+    /// Glass and panels: a display colour with coverage; opaque surfaces: alpha 1.
+    pub tint: LinearRgba,
+    pub mode: RenderMode,
+    pub scale_max_lux: f32,
+    /// Drawn behind the patch meshes, filling their cracks.
+    pub underlay: bool,
+}
+
+/// What changes the pipeline: the underlay's depth bias.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct LightingMaterialKey {
+    underlay: bool,
+}
+
+impl From<&LightingMaterial> for LightingMaterialKey {
+    fn from(material: &LightingMaterial) -> Self {
+        Self { underlay: material.underlay }
+    }
+}
+
+#[derive(ShaderType, Clone, Copy)]
+pub struct LightingMaterialUniform {
+    tint: Vec4,
+    mode: u32,
+    scale_max_lux: f32,
+}
+
+impl bevy::render::render_resource::AsBindGroupShaderType<LightingMaterialUniform> for LightingMaterial {
+    fn as_bind_group_shader_type(&self, _: &bevy::render::render_asset::RenderAssets<bevy::render::texture::GpuImage>) -> LightingMaterialUniform {
+        LightingMaterialUniform {
+            tint: self.tint.to_vec4(),
+            mode: u32::from(self.mode == RenderMode::FalseColour),
+            scale_max_lux: self.scale_max_lux,
+        }
+    }
+}
+
+impl Material for LightingMaterial {
+    fn fragment_shader() -> ShaderRef {
+        LIGHTING_SHADER.into()
+    }
+
+    fn alpha_mode(&self) -> AlphaMode {
+        if self.tint.alpha < 1.0 { AlphaMode::Blend } else { AlphaMode::Opaque }
+    }
+
+    fn specialize(
+        _: &bevy::pbr::MaterialPipeline,
+        descriptor: &mut bevy::render::render_resource::RenderPipelineDescriptor,
+        _: &bevy::mesh::MeshVertexBufferLayoutRef,
+        key: bevy::pbr::MaterialPipelineKey<Self>,
+    ) -> Result<(), bevy::render::render_resource::SpecializedMeshPipelineError> {
+        // Reverse Z: a negative bias moves the underlay away from the camera.
+        if key.bind_group_data.underlay
+            && let Some(depth) = descriptor.depth_stencil.as_mut()
+        {
+            depth.bias.constant = -16;
+            depth.bias.slope_scale = -2.0;
+        }
+        Ok(())
+    }
+}
+
+/// Glass as a faint blue-grey, panels amber: readable at any exposure.
+const GLASS_TINT: LinearRgba = LinearRgba::new(0.35, 0.45, 0.55, 0.18);
+const PANEL_TINT: LinearRgba = LinearRgba::new(0.7, 0.5, 0.2, 0.3);
+
+/// A mesh of one diffuse material with how its vertices take the light.
+#[derive(Component, Default)]
+pub struct SurfaceValues {
+    reflectance: [f32; 3],
+    /// Per mesh vertex, its node.
+    vertex_node: Vec<u32>,
+    /// Per node, the patch sides meeting there with their weights (areas).
+    nodes: Vec<Vec<(u32, f32)>>,
+}
+
+fn spawn_surface_meshes(
+    mut commands: Commands,
+    mut spawned: MessageReader<SceneSpawned>,
+    active: Res<ActiveScene>,
+    settings: Res<RenderSettings>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<LightingMaterial>>,
+) {
+    let Some(SceneSpawned { root }) = spawned.read().last() else { return };
+    let Some(scene) = &active.scene else { return };
+    for (index, material) in scene.materials.iter().enumerate() {
+        let Some((mesh, values)) = material_mesh(scene, index as u32) else { continue };
+        let tint = match &material.kind {
+            MaterialKind::Diffuse { .. } => LinearRgba::BLACK,
+            MaterialKind::Glass { .. } => GLASS_TINT,
+            MaterialKind::Panel { .. } => PANEL_TINT,
+        };
+        let lighting = |underlay| LightingMaterial { tint, mode: settings.mode, scale_max_lux: settings.false_colour_max_lux, underlay };
+        let mut entity = commands.spawn((Mesh3d(meshes.add(mesh)), MeshMaterial3d(materials.add(lighting(false))), ChildOf(*root)));
+        if let MaterialKind::Diffuse { reflectance } = &material.kind {
+            entity.insert(SurfaceValues { reflectance: reflectance.0, ..values });
+            let (mesh, values) = underlay_mesh(scene, index as u32);
+            commands.spawn((
+                Mesh3d(meshes.add(mesh)),
+                MeshMaterial3d(materials.add(lighting(true))),
+                SurfaceValues { reflectance: reflectance.0, ..values },
+                ChildOf(*root),
+            ));
+        }
+    }
+}
+
+/// Both sides of the model's triangles of a diffuse `material`, each
+/// surface side one node holding all its patches.
+fn underlay_mesh(scene: &Scene, material: u32) -> (Mesh, SurfaceValues) {
+    let mut builder = MeshBuilder::default();
+    for surface in scene.surfaces.iter().filter(|s| s.material == material) {
+        for back in [false, true] {
+            let sides: Vec<(u32, f32)> = (surface.patches.clone()).map(|p| (side_of(p, back), scene.patches.patches[p as usize].area)).collect();
+            let node = builder.values.nodes.len() as u32;
+            builder.values.nodes.push(sides);
+            let normal = if back { -surface.normal } else { surface.normal };
+            for triangle in &scene.triangles[surface.triangles.start as usize..surface.triangles.end as usize] {
+                let [a, b, c] = triangle.vertices;
+                builder.triangle(if back { [a, c, b] } else { [a, b, c] }, normal, [node; 3]);
+            }
+        }
+    }
+    builder.build()
+}
+
+/// Vertices with their nodes, and the mesh they make.
+#[derive(Default)]
+struct MeshBuilder {
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    values: SurfaceValues,
+}
+
+impl MeshBuilder {
+    fn triangle(&mut self, vertices: [Vec3; 3], normal: Vec3, nodes: [u32; 3]) {
+        for (v, node) in vertices.into_iter().zip(nodes) {
+            self.values.vertex_node.push(node);
+            self.positions.push(v.to_array());
+            self.normals.push(normal.to_array());
+        }
+    }
+
+    fn build(self) -> (Mesh, SurfaceValues) {
+        let colours = vec![[0.0f32; 4]; self.positions.len()];
+        let mesh = Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::default())
+            .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, self.positions)
+            .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, self.normals)
+            .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, colours);
+        (mesh, self.values)
+    }
+}
+
+/// Both sides of every patch of `material` (the back side wound the other
+/// way), with vertex nodes shared within one surface and side.
+fn material_mesh(scene: &Scene, material: u32) -> Option<(Mesh, SurfaceValues)> {
+    let mut builder = MeshBuilder::default();
+    let mut node_of: HashMap<(u32, bool, [i64; 3]), u32> = HashMap::new();
+    for (p, patch) in scene.patches.patches.iter().enumerate().filter(|(_, p)| p.material == material) {
+        let triangles = &scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize];
+        for back in [false, true] {
+            let side = side_of(p as u32, back);
+            let normal = if back { -patch.normal } else { patch.normal };
+            for triangle in triangles {
+                let t = if back { [triangle[0], triangle[2], triangle[1]] } else { *triangle };
+                let area = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+                let nodes = t.map(|v| {
+                    let nodes = &mut builder.values.nodes;
+                    let key = (patch.surface, back, v.to_array().map(|c| (f64::from(c) * 1e4).round() as i64));
+                    let node = *node_of.entry(key).or_insert(nodes.len() as u32);
+                    if node as usize == nodes.len() {
+                        nodes.push(Vec::new());
+                    }
+                    nodes[node as usize].push((side, area));
+                    node
+                });
+                builder.triangle(t, normal, nodes);
+            }
+        }
+    }
+    (!builder.positions.is_empty()).then(|| builder.build())
+}
+
+/// What a patch side shows in a mode: luminance (cd/m², RGB) or, for false
+/// colour, illuminance (lux) in the first channel.
+pub fn side_value(channels: &Channels, reflectance: [f32; 3], mode: RenderMode) -> [f32; 3] {
+    let luminance = |irradiance: [f64; 3]| {
+        [0, 1, 2].map(|c| (f64::from(reflectance[c]) / PI * irradiance[c] * LUMINOUS_EFFICACY) as f32)
+    };
+    match mode {
+        RenderMode::Full => luminance(channels.indirect.map(|i| i + channels.sky)),
+        RenderMode::Sun => [0.0; 3],
+        RenderMode::Sky => luminance([channels.sky; 3]),
+        RenderMode::Indirect => luminance(channels.indirect),
+        RenderMode::FalseColour => {
+            [((channels.sun + channels.sky + channels.indirect_luminous()) * LUMINOUS_EFFICACY) as f32, 0.0, 0.0]
+        }
+    }
+}
+
+fn update_surface_values(
+    state: Option<Res<LightingState>>,
+    settings: Res<RenderSettings>,
+    surfaces: Query<(&Mesh3d, &MeshMaterial3d<LightingMaterial>, Option<&SurfaceValues>)>,
+    added: Query<(), Added<SurfaceValues>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<LightingMaterial>>,
+) {
+    if !state.as_ref().is_some_and(|s| s.is_changed()) && !settings.is_changed() && added.is_empty() {
+        return;
+    }
+    for (mesh, material, values) in &surfaces {
+        if settings.is_changed()
+            && let Some(mut material) = materials.get_mut(&material.0)
+        {
+            material.mode = settings.mode;
+            material.scale_max_lux = settings.false_colour_max_lux;
+        }
+        let (Some(values), Some(lighting)) = (values, state.as_ref().and_then(|s| s.lighting.as_ref())) else { continue };
+        let node_values: Vec<[f32; 3]> = values
+            .nodes
+            .iter()
+            .map(|sides| {
+                let total: f32 = sides.iter().map(|s| s.1).sum();
+                let mut sum = [0.0f32; 3];
+                for &(side, weight) in sides {
+                    let value = side_value(&lighting.sides[side as usize], values.reflectance, settings.mode);
+                    (0..3).for_each(|c| sum[c] += weight * value[c]);
+                }
+                sum.map(|s| s / total.max(f32::MIN_POSITIVE))
+            })
+            .collect();
+        let colours: Vec<[f32; 4]> = values.vertex_node.iter().map(|&n| {
+            let [r, g, b] = node_values[n as usize];
+            [r, g, b, 1.0]
+        }).collect();
+        if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
+            mesh.insert_attribute(Mesh::ATTRIBUTE_COLOR, colours);
+        }
+    }
+}
