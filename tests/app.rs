@@ -255,82 +255,189 @@ fn camera_rays(view: &Viewpoint, width: u32, height: u32) -> Vec<DVec3> {
         .collect()
 }
 
-/// The direct-sun image (mode `sun`) against a CPU ray tracer: each pixel's
-/// ray finds its surface, then a shadow ray from there toward the sun goes
-/// through glass (Radiance's transmittance) or meets an opaque surface.
-/// Pixels whose ray meets glass or nothing are not compared.
+/// How a direct-sun image (mode `sun`) agrees with the CPU reference.
+struct SunComparison {
+    /// Pixels whose ray meets a diffuse surface.
+    compared: usize,
+    /// Share of them that agree on lit or unlit.
+    agreement: f64,
+    /// Pixels lit in both.
+    lit: usize,
+    /// Share of those within 2% of the reference.
+    within: f64,
+    worst: f64,
+    summary: String,
+}
+
+/// Renders the direct sun of a view and compares it with a CPU ray tracer:
+/// each pixel's ray finds its surface, then a shadow ray from there toward
+/// the sun goes through glass (Radiance's transmittance) or meets an opaque
+/// surface. Pixels whose ray meets glass or nothing are not compared. The
+/// image and a map of disagreements (red: only the reference is lit, green:
+/// only the image) are written to the test's temporary folder.
+fn compare_direct_sun(path: &std::path::Path, view: &Viewpoint, date: &str, time: &str) -> SunComparison {
+    let (width, height) = (320u32, 200u32);
+    let scene = Arc::new(load_scene(path, &PanelNames::new()).unwrap().scene);
+    let model = LightModel::unlit(scene.clone());
+    let when = LocalDateTime { date: Date::parse(date).unwrap(), time: TimeOfDay::parse(time).unwrap() };
+    let position = solar_position(&scene.site, &when);
+    let sky = Sky::new(&SkySpec::Clear { turbidity: 2.45 }, position.altitude, position.azimuth, scene.site.ground_reflectance, when.date.day_of_year()).unwrap();
+    let sun = sky.sun.expect("the sun is up");
+    let request = OffscreenRequest {
+        scene: path.to_path_buf(),
+        view: Some(view.clone()),
+        width,
+        height,
+        when: Some(when),
+        sky: Some(SkySpec::Clear { turbidity: 2.45 }),
+        settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
+    };
+    let image = offscreen::render(request).expect("render");
+    let scene_name = path.parent().and_then(|p| p.file_name()).unwrap().to_string_lossy();
+    let file = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("sun_{scene_name}_{}_{}.png", view.name.replace(' ', "_"), time.replace(':', "")));
+    image.save_png(&file).unwrap();
+    let (mut compared, mut agree, mut lit, mut within) = (0usize, 0usize, 0usize, 0usize);
+    let mut worst: f64 = 0.0;
+    let mut disagreement = image::RgbImage::new(width, height);
+    let eye = view.eye.as_dvec3();
+    for (k, (ray, gpu)) in camera_rays(view, width, height).into_iter().zip(&image.physical).enumerate() {
+        let Some((patch, distance)) = model.trace(eye, ray) else { continue };
+        let patch = &scene.patches.patches[patch as usize];
+        let MaterialKind::Diffuse { reflectance } = &scene.materials[patch.material as usize].kind else { continue };
+        let mut normal = patch.normal.as_dvec3();
+        if normal.dot(ray) > 0.0 {
+            normal = -normal;
+        }
+        let irradiance = model.sun_irradiance(eye + ray * distance, normal, &sun);
+        let expected = f64::from(reflectance.0[1]) / std::f64::consts::PI * irradiance * 179.0;
+        let got = f64::from(gpu[1]);
+        compared += 1;
+        let (cpu_lit, gpu_lit) = (expected > 1.0, got > 1.0);
+        agree += usize::from(cpu_lit == gpu_lit);
+        let shade = if cpu_lit == gpu_lit { [40 + 80 * u8::from(cpu_lit); 3] } else if cpu_lit { [255, 0, 0] } else { [0, 255, 0] };
+        disagreement.put_pixel(k as u32 % width, k as u32 / width, image::Rgb(shade));
+        if cpu_lit && gpu_lit {
+            lit += 1;
+            let error = (got / expected - 1.0).abs();
+            within += usize::from(error <= 0.02);
+            worst = worst.max(error);
+        }
+    }
+    disagreement.save(file.with_extension("diff.png")).unwrap();
+    let agreement = agree as f64 / compared.max(1) as f64;
+    let within = within as f64 / lit.max(1) as f64;
+    let summary = format!(
+        "{scene_name} {} {date} {time}: {compared} pixels, lit/unlit agree {:.2}%, {lit} lit, {:.2}% within 2% (worst {:.1}%) -> {}",
+        view.name,
+        100.0 * agreement,
+        100.0 * within,
+        100.0 * worst,
+        file.display()
+    );
+    println!("{summary}");
+    SunComparison { compared, agreement, lit, within, worst, summary }
+}
+
+/// Every bundled scene from its first camera at two sun positions and from
+/// outside at a third.
 #[test]
 fn direct_sun_images_agree_with_a_ray_traced_reference() {
-    let (width, height) = (320u32, 200u32);
-    let out_dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
-    let mut report = Vec::new();
     for name in heliodon::BUNDLED_SCENES {
         let path = heliodon::bundled_scene(name);
-        let scene = Arc::new(load_scene(&path, &PanelNames::new()).unwrap().scene);
-        let model = LightModel::unlit(scene.clone());
-        let overview = Viewpoint { name: "overview".into(), ..initial_view(&Scene { viewpoints: Vec::new(), ..(*scene).clone() }) };
-        let cases = [(scene.viewpoints[0].clone(), "2026-03-21", "10:00"), (scene.viewpoints[0].clone(), "2026-11-10", "14:30"), (overview, "2026-12-21", "12:00")];
+        let scene = load_scene(&path, &PanelNames::new()).unwrap().scene;
+        let overview = initial_view(&Scene { viewpoints: Vec::new(), ..scene.clone() });
+        let cases = [(&scene.viewpoints[0], "2026-03-21", "10:00"), (&scene.viewpoints[0], "2026-11-10", "14:30"), (&overview, "2026-12-21", "12:00")];
         for (view, date, time) in cases {
-            let when = LocalDateTime { date: Date::parse(date).unwrap(), time: TimeOfDay::parse(time).unwrap() };
-            let sun = solar_position(&scene.site, &when);
-            let sky = Sky::new(&SkySpec::Clear { turbidity: 2.45 }, sun.altitude, sun.azimuth, scene.site.ground_reflectance, when.date.day_of_year()).unwrap();
-            let sun = sky.sun.expect("the sun is up in every case");
-            let request = OffscreenRequest {
-                scene: path.clone(),
-                view: Some(view.clone()),
-                width,
-                height,
-                when: Some(when),
-                sky: Some(SkySpec::Clear { turbidity: 2.45 }),
-                settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
-            };
-            let image = offscreen::render(request).expect("render");
-            let file = out_dir.join(format!("sun_{name}_{}_{}.png", view.name.replace(' ', "_"), time.replace(':', "")));
-            image.save_png(&file).unwrap();
-            let (mut compared, mut agree, mut lit, mut within) = (0usize, 0usize, 0usize, 0usize);
-            let mut worst: f64 = 0.0;
-            // Disagreements for a person to look at: red where only the
-            // reference is lit, green where only the image is.
-            let mut disagreement = image::RgbImage::new(width, height);
-            for (k, (ray, gpu)) in camera_rays(&view, width, height).into_iter().zip(&image.physical).enumerate() {
-                let eye = view.eye.as_dvec3();
-                let Some((patch, distance)) = model.trace(eye, ray) else { continue };
-                let patch = &scene.patches.patches[patch as usize];
-                let MaterialKind::Diffuse { reflectance } = &scene.materials[patch.material as usize].kind else { continue };
-                let mut normal = patch.normal.as_dvec3();
-                if normal.dot(ray) > 0.0 {
-                    normal = -normal;
-                }
-                let irradiance = model.sun_irradiance(eye + ray * distance, normal, &sun);
-                let expected = f64::from(reflectance.0[1]) / std::f64::consts::PI * irradiance * 179.0;
-                let got = f64::from(gpu[1]);
-                compared += 1;
-                let (cpu_lit, gpu_lit) = (expected > 1.0, got > 1.0);
-                agree += usize::from(cpu_lit == gpu_lit);
-                let shade = if cpu_lit == gpu_lit { [40 + 80 * u8::from(cpu_lit); 3] } else if cpu_lit { [255, 0, 0] } else { [0, 255, 0] };
-                disagreement.put_pixel(k as u32 % width, k as u32 / width, image::Rgb(shade));
-                if cpu_lit && gpu_lit {
-                    lit += 1;
-                    let error = (got / expected - 1.0).abs();
-                    within += usize::from(error <= 0.02);
-                    worst = worst.max(error);
-                }
-            }
-            disagreement.save(file.with_extension("diff.png")).unwrap();
-            let agreement = agree as f64 / compared as f64;
-            let within = within as f64 / lit.max(1) as f64;
-            report.push(format!(
-                "{name} {} {date} {time}: {compared} pixels, lit/unlit agree {:.2}%, {lit} lit, {:.2}% within 2% (worst {:.1}%) -> {}",
-                view.name,
-                100.0 * agreement,
-                100.0 * within,
-                100.0 * worst,
-                file.display()
-            ));
-            println!("{}", report.last().unwrap());
-            assert!(compared > (width * height / 10) as usize, "{}", report.last().unwrap());
-            assert!(lit > 200, "too few sunlit pixels to compare: {}", report.last().unwrap());
-            assert!(agreement >= 0.99 && within >= 0.99, "{}", report.last().unwrap());
+            let result = compare_direct_sun(&path, view, date, time);
+            assert!(result.compared > 320 * 200 / 10, "{}", result.summary);
+            assert!(result.lit > 200, "too few sunlit pixels to compare: {}", result.summary);
+            assert!(result.agreement >= 0.99 && result.within >= 0.99, "{}", result.summary);
         }
+    }
+}
+
+/// Depth-fail stencil counting: a camera standing in the sunbeam of a
+/// window, and one in the room's shadow, both see the sun patches right.
+#[test]
+fn cameras_inside_a_sunbeam_and_inside_a_shadow_see_the_sun_right() {
+    let path = heliodon::bundled_scene("test_room");
+    let scene = Arc::new(load_scene(&path, &PanelNames::new()).unwrap().scene);
+    let model = LightModel::unlit(scene.clone());
+    let when = LocalDateTime { date: Date::parse("2026-03-21").unwrap(), time: TimeOfDay::parse("10:00").unwrap() };
+    let position = solar_position(&scene.site, &when);
+    let sky = Sky::new(&SkySpec::Clear { turbidity: 2.45 }, position.altitude, position.azimuth, 0.2, 80).unwrap();
+    let sun = sky.sun.unwrap();
+    // Half a metre in from the middle of the lower middle pane, along the beam.
+    let pane = scene.windows.iter().min_by(|a, b| (a.centroid.x - 2.0).abs().total_cmp(&(b.centroid.x - 2.0).abs()).then(a.centroid.z.total_cmp(&b.centroid.z))).unwrap();
+    let in_beam = pane.centroid.as_dvec3() - sun.direction * 0.5;
+    let floor_patch = in_beam - sun.direction * (in_beam.z / sun.direction.z);
+    assert!(model.sun_irradiance(in_beam, sun.direction, &sun) > 0.0, "the eye is in the beam");
+    let in_shadow = glam::DVec3::new(0.6, 5.0, 2.5);
+    assert_eq!(model.sun_irradiance(in_shadow, sun.direction, &sun), 0.0, "the eye is in shadow");
+    for (name, eye, target) in [("in beam", in_beam, floor_patch), ("in shadow", in_shadow, floor_patch)] {
+        let view = Viewpoint { name: name.into(), eye: eye.as_vec3(), target: target.as_vec3(), fov: 75.0 };
+        let result = compare_direct_sun(&path, &view, "2026-03-21", "10:00");
+        assert!(result.lit > 1000, "the floor patch fills much of the view: {}", result.summary);
+        assert!(result.agreement >= 0.99 && result.within >= 0.99, "{}", result.summary);
+    }
+}
+
+/// Real models are rarely clean: an open box, a duplicated face and
+/// T-junctions still cast exact shadows, with no holes or streaks.
+#[test]
+fn non_manifold_models_cast_shadows_without_holes_or_streaks() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("non_manifold");
+    std::fs::create_dir_all(&dir).unwrap();
+    let obj = "\
+mtllib model.mtl
+usemtl ground
+v -4 -4 0
+v 8 -4 0
+v 8 8 0
+v -4 8 0
+f 1 2 3 4
+usemtl wall
+# An open box (no lid, no floor), single-sided walls.
+v 0 0 0
+v 2 0 0
+v 2 2 0
+v 0 2 0
+v 0 0 1.5
+v 2 0 1.5
+v 2 2 1.5
+v 0 2 1.5
+f 5 6 10 9
+f 6 7 11 10
+f 7 8 12 11
+f 8 5 9 12
+# The east wall again, duplicated.
+f 6 7 11 10
+# A screen whose long top edge meets two short panels below it: T-junctions.
+v 4 0 2
+v 6 0 2
+v 6 0 3
+v 4 0 3
+v 5 0 2
+v 4 0 1
+v 5 0 1
+v 6 0 1
+f 13 14 15 16
+f 18 19 17 13
+f 19 20 14 17
+";
+    std::fs::write(dir.join("model.obj"), obj).unwrap();
+    std::fs::write(dir.join("model.mtl"), "newmtl ground\nKd 0.3 0.3 0.3\nnewmtl wall\nKd 0.6 0.6 0.6\n").unwrap();
+    let scene_text = "name = \"Non-manifold\"\n[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n[model]\nobj = \"model.obj\"\n";
+    std::fs::write(dir.join("scene.toml"), scene_text).unwrap();
+    let path = dir.join("scene.toml");
+    let views = [
+        Viewpoint { name: "above".into(), eye: glam::Vec3::new(1.0, -6.0, 9.0), target: glam::Vec3::new(2.0, 2.0, 0.0), fov: 60.0 },
+        // From the south-east, with the duplicated wall's face in the sun.
+        Viewpoint { name: "low".into(), eye: glam::Vec3::new(5.0, -3.0, 1.2), target: glam::Vec3::new(1.0, 1.0, 0.7), fov: 70.0 },
+    ];
+    for (view, time) in views.iter().zip(["15:00", "10:00"]) {
+        let result = compare_direct_sun(&path, view, "2026-03-21", time);
+        assert!(result.lit > 1000, "{}", result.summary);
+        assert!(result.agreement >= 0.99 && result.within >= 0.99, "{}", result.summary);
     }
 }

@@ -133,11 +133,19 @@ impl SunPassFrame {
 
 /// The diffuse surfaces as the sun pass draws them: the very triangles of
 /// the patch meshes the main pass drew, so their depths match exactly.
+/// A face the model holds twice is drawn once (light is added, so a
+/// duplicate would double it).
 pub fn lit_vertices(scene: &Scene) -> Vec<f32> {
     let mut out = Vec::new();
+    let mut seen = std::collections::HashSet::new();
     for patch in &scene.patches.patches {
         let MaterialKind::Diffuse { reflectance } = &scene.materials[patch.material as usize].kind else { continue };
         for triangle in &scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize] {
+            let mut key = triangle.map(|v| v.to_array().map(f32::to_bits));
+            key.sort_unstable();
+            if !seen.insert(key) {
+                continue;
+            }
             for v in triangle {
                 out.extend(v.to_array());
                 out.extend(patch.normal.to_array());
