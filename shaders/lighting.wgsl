@@ -20,7 +20,8 @@ struct LightingMaterial {
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var<uniform> material: LightingMaterial;
 
 // The false-colour scale: logarithmic over three decades below the top,
-// blue, cyan, green, yellow, red, white.
+// blue, cyan, green, yellow, red, white (heliodon::render::false_colour is
+// the same scale on the CPU, for legends).
 fn false_colour(lux: f32, top: f32) -> vec3<f32> {
     let t = clamp(log2(max(lux, 1e-6) / top) / log2(1000.0) + 1.0, 0.0, 1.0);
     let stops = array<vec3<f32>, 6>(

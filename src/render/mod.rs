@@ -5,6 +5,7 @@
 //! filmic tone mapping turn the physical values (cd/m²) into a picture.
 //! Also the initial view of a scene and offscreen rendering ([`offscreen`]).
 
+pub mod legend;
 pub mod offscreen;
 pub mod shadow_volume;
 pub mod sun_pass;
@@ -19,8 +20,8 @@ use bevy::render::render_resource::TextureUsages;
 use bevy::camera::Hdr;
 use bevy::render::view::Msaa;
 
-use crate::ecs::{ActiveScene, HeliodonSystems, LightingState, SunSky};
-use crate::light::side_of;
+use crate::ecs::{ActiveScene, HeliodonSystems, LightEngine, LightingState, SunSky};
+use crate::light::{Channels, LightModel, side_of};
 use crate::scene::{DEFAULT_FOV, MaterialKind, Scene, Viewpoint};
 use sun_pass::{SunPassFrame, SunPassInput, SunPassPlugin, SunPassView, lit_vertices};
 use surfaces::{SurfaceLightingPlugin, side_value};
@@ -35,7 +36,7 @@ impl Plugin for HeliodonRenderPlugin {
         app.insert_resource(ClearColor(BACKGROUND))
             .init_resource::<RenderSettings>()
             .add_plugins((SurfaceLightingPlugin, SunPassPlugin))
-            .add_systems(Update, (update_sun_pass, auto_exposure).after(HeliodonSystems::Lighting));
+            .add_systems(Update, (update_sun_pass, auto_exposure, tone_mapping_for_mode).after(HeliodonSystems::Lighting));
     }
 }
 
@@ -92,10 +93,37 @@ pub fn hybrid_camera() -> impl Bundle {
         Camera3d { depth_texture_usages: (TextureUsages::RENDER_ATTACHMENT | TextureUsages::TEXTURE_BINDING).into(), ..default() },
         Hdr,
         Msaa::Off,
-        Tonemapping::AgX,
+        FILMIC,
         Exposure::default(),
         SunPassView,
     )
+}
+
+/// False colour is shown as computed; every other mode is tone-mapped.
+fn tone_mapping_for_mode(
+    settings: Res<RenderSettings>,
+    mut cameras: Query<(Ref<SunPassView>, &mut Tonemapping), Without<PhysicalUnits>>,
+) {
+    let wanted = if settings.mode == RenderMode::FalseColour { Tonemapping::None } else { FILMIC };
+    for (view, mut tonemapping) in &mut cameras {
+        if (settings.is_changed() || view.is_added()) && *tonemapping != wanted {
+            *tonemapping = wanted;
+        }
+    }
+}
+
+/// The filmic tone map of pictures.
+const FILMIC: Tonemapping = Tonemapping::AgX;
+
+/// The false-colour scale (shaders/lighting.wgsl draws the same): linear
+/// RGB for an illuminance, logarithmic over the three decades below `top`.
+pub fn false_colour(lux: f32, top: f32) -> [f32; 3] {
+    const STOPS: [[f32; 3]; 6] = [[0.02, 0.02, 0.35], [0.0, 0.45, 0.9], [0.05, 0.75, 0.25], [0.95, 0.9, 0.1], [0.9, 0.15, 0.05], [1.0, 1.0, 1.0]];
+    let t = ((lux.max(1e-6) / top).log2() / 1000f32.log2() + 1.0).clamp(0.0, 1.0);
+    let x = t * 5.0;
+    let i = (x.floor() as usize).min(4);
+    let f = x - i as f32;
+    [0, 1, 2].map(|c| STOPS[i][c] * (1.0 - f) + STOPS[i + 1][c] * f)
 }
 
 /// A camera whose image holds physical values: luminance in cd/m² (its
@@ -140,58 +168,84 @@ fn update_sun_pass(
     input.0 = Some(Arc::new(frame));
 }
 
-/// With automatic exposure, meters the scene's light as it lands, as a
-/// reflected-light meter would (EV100 = log2(L · 100 / 12.5)): L is the
-/// log-average luminance of all lit surfaces, sun included, or with direct
-/// sun alone, that of a mid-grey surface facing the sun.
+/// With automatic exposure, meters what each camera sees as a
+/// photographer would: the log-average luminance L of the surfaces in view
+/// (sun included, weighted by the solid angle they fill) is mapped to
+/// middle grey, 0.18 (EV100 = log2(1.2 · L / 0.18) in Bevy's terms). With
+/// direct sun alone, L is that of a mid-grey surface facing the sun.
+#[allow(clippy::too_many_arguments)]
 fn auto_exposure(
     state: Option<Res<LightingState>>,
+    engine: Option<Res<LightEngine>>,
     sun_sky: Option<Res<SunSky>>,
     settings: Res<RenderSettings>,
     active: Res<ActiveScene>,
-    mut cameras: Query<&mut Exposure, (With<SunPassView>, Without<PhysicalUnits>)>,
-    added: Query<(), Added<SunPassView>>,
+    mut cameras: Query<(Ref<GlobalTransform>, &Projection, &mut Exposure), (With<SunPassView>, Without<PhysicalUnits>)>,
 ) {
     let light_changed = state.as_ref().is_some_and(|s| s.is_changed()) || sun_sky.as_ref().is_some_and(|s| s.is_changed());
-    if !light_changed && !settings.is_changed() && added.is_empty() {
-        return;
-    }
-    let metered = match (&active.scene, state.as_ref().and_then(|s| s.lighting.as_ref())) {
-        _ if settings.mode == RenderMode::Sun => sun_sky
-            .as_ref()
-            .and_then(|s| s.sky.sun)
-            .filter(|sun| sun.direction.z > 0.0)
-            .map(|sun| MID_GREY / std::f64::consts::PI * sun.normal_irradiance() * crate::sky::LUMINOUS_EFFICACY),
-        (Some(scene), Some(lighting)) => log_average_luminance(scene, &lighting.sides),
-        _ => None,
-    };
-    let Some(ev100) = settings.exposure.or(metered.map(|luminance| (luminance * 100.0 / 12.5).log2() as f32)) else { return };
-    for mut exposure in &mut cameras {
-        exposure.ev100 = ev100;
+    for (transform, projection, mut exposure) in &mut cameras {
+        if !light_changed && !settings.is_changed() && !transform.is_changed() {
+            continue;
+        }
+        let metered = if settings.mode == RenderMode::Sun {
+            sun_sky
+                .as_ref()
+                .and_then(|s| s.sky.sun)
+                .filter(|sun| sun.direction.z > 0.0)
+                .map(|sun| MIDDLE_GREY / std::f64::consts::PI * sun.normal_irradiance() * crate::sky::LUMINOUS_EFFICACY)
+        } else {
+            match (&active.scene, state.as_ref().and_then(|s| s.lighting.as_ref()), engine.as_ref().and_then(|e| e.model.as_ref())) {
+                (Some(scene), Some(lighting), Some(model)) => metered_luminance(scene, model, &lighting.sides, &transform, projection),
+                _ => None,
+            }
+        };
+        if let Some(ev100) = settings.exposure.or(metered.map(|luminance| (1.2 * luminance / MIDDLE_GREY).log2() as f32)) {
+            exposure.ev100 = ev100;
+        }
     }
 }
 
-/// Reflectance of the surface the direct-sun view is metered on.
-const MID_GREY: f64 = 0.18;
+/// Reflectance that automatic exposure shows as middle grey.
+const MIDDLE_GREY: f64 = 0.18;
+/// Patches metered at most per exposure update (evenly spread).
+const METERED_PATCHES: usize = 4096;
 
-/// Area-weighted log-average luminance (cd/m²) of the diffuse patch sides
-/// that receive any light.
-fn log_average_luminance(scene: &Scene, sides: &[crate::light::Channels]) -> Option<f64> {
-    let (mut sum, mut area) = (0.0, 0.0);
-    for (p, patch) in scene.patches.patches.iter().enumerate() {
+/// Log-average luminance (cd/m²) of the diffuse patch sides a camera sees
+/// (facing it, inside its view cone, not hidden), weighted by solid angle.
+fn metered_luminance(scene: &Scene, model: &LightModel, sides: &[Channels], camera: &GlobalTransform, projection: &Projection) -> Option<f64> {
+    let eye = camera.translation().as_dvec3();
+    let forward = camera.forward().as_vec3().as_dvec3();
+    let Projection::Perspective(perspective) = projection else { return None };
+    let half_diagonal = ((perspective.fov / 2.0).tan() * (1.0 + perspective.aspect_ratio.powi(2)).sqrt()).atan();
+    let cos_cone = f64::from(half_diagonal.cos());
+    let patches = &scene.patches.patches;
+    let step = patches.len().div_ceil(METERED_PATCHES).max(1);
+    let (mut sum, mut weight) = (0.0, 0.0);
+    for p in (0..patches.len()).step_by(step) {
+        let patch = &patches[p];
         let MaterialKind::Diffuse { reflectance } = &scene.materials[patch.material as usize].kind else { continue };
-        for back in [false, true] {
-            let channels = sides.get(side_of(p as u32, back) as usize)?;
-            let with_sun = crate::light::Channels { sky: channels.sky + channels.sun, ..*channels };
-            let [r, g, b] = side_value(&with_sun, reflectance.0, RenderMode::Full);
-            let luminance = f64::from(0.265 * r + 0.670 * g + 0.065 * b);
-            if luminance > 1e-3 {
-                sum += f64::from(patch.area) * luminance.ln();
-                area += f64::from(patch.area);
-            }
+        let to_patch = patch.centroid.as_dvec3() - eye;
+        let distance = to_patch.length();
+        let direction = to_patch / distance;
+        let back = direction.dot(patch.normal.as_dvec3()) > 0.0;
+        let cos_view = direction.dot(patch.normal.as_dvec3()).abs();
+        if direction.dot(forward) < cos_cone || cos_view < 1e-3 {
+            continue;
+        }
+        if model.trace(eye, direction).is_some_and(|(hit, t)| hit as usize != p && t < distance - 1e-3) {
+            continue;
+        }
+        let Some(channels) = sides.get(side_of(p as u32, back) as usize) else { return None };
+        let with_sun = Channels { sky: channels.sky + channels.sun, ..*channels };
+        let [r, g, b] = side_value(&with_sun, reflectance.0, RenderMode::Full);
+        let luminance = f64::from(0.265 * r + 0.670 * g + 0.065 * b);
+        if luminance > 1e-3 {
+            let solid_angle = f64::from(patch.area) * cos_view / (distance * distance);
+            sum += solid_angle * luminance.ln();
+            weight += solid_angle;
         }
     }
-    (area > 0.0).then(|| (sum / area).exp())
+    (weight > 0.0).then(|| (sum / weight).exp())
 }
 
 /// The view a scene opens on: its first `[[cameras]]` entry, else the whole

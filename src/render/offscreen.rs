@@ -110,10 +110,10 @@ struct Job {
     failure: Option<String>,
 }
 
-/// Renders one frame of a scene. Errors are one line.
-pub fn render(request: OffscreenRequest) -> Result<RenderedImage, String> {
-    let picture = Arc::new(Mutex::new(None));
-    let physical = Arc::new(Mutex::new(None));
+/// A headless app that opens the request's scene and draws its view into
+/// two images every update. [`render`] runs it until one frame is captured;
+/// a benchmark drives it with `update()`.
+pub fn offscreen_app(request: &OffscreenRequest) -> App {
     let mut app = App::new();
     app.add_plugins(
         DefaultPlugins
@@ -122,8 +122,7 @@ pub fn render(request: OffscreenRequest) -> Result<RenderedImage, String> {
             .set(crate::asset_plugin())
             .disable::<WinitPlugin>()
             .disable::<LogPlugin>(),
-    )
-    .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::ZERO));
+    );
     // Direct sun alone needs no light engine: skip its precomputation.
     if request.settings.mode == RenderMode::Sun {
         app.add_plugins(HeliodonPlugins.build().disable::<LightingPlugin>());
@@ -137,8 +136,8 @@ pub fn render(request: OffscreenRequest) -> Result<RenderedImage, String> {
             targets: None,
             frames_drawn: 0,
             capture_requested: false,
-            picture: picture.clone(),
-            physical: physical.clone(),
+            picture: Arc::default(),
+            physical: Arc::default(),
             failure: None,
         })
         .add_systems(Startup, |job: Res<Job>, mut open: MessageWriter<OpenScene>, mut time: ResMut<SolarTime>, mut sky: ResMut<SkyChoice>| {
@@ -150,7 +149,25 @@ pub fn render(request: OffscreenRequest) -> Result<RenderedImage, String> {
                 sky.0 = spec;
             }
         })
-        .add_systems(Update, (spawn_cameras, capture, finish).chain().after(crate::ecs::HeliodonSystems::SpawnScene))
+        .add_systems(Update, (spawn_cameras, count_ready_frames).chain().after(crate::ecs::HeliodonSystems::SpawnScene));
+    app
+}
+
+/// Whether the app of [`offscreen_app`] draws its final picture: the light
+/// it shows has arrived and enough frames have passed for it to be drawn.
+pub fn frame_ready(app: &App) -> bool {
+    app.world().get_resource::<Job>().is_some_and(|job| job.frames_drawn >= WARM_UP_FRAMES)
+}
+
+/// Renders one frame of a scene. Errors are one line.
+pub fn render(request: OffscreenRequest) -> Result<RenderedImage, String> {
+    let mut app = offscreen_app(&request);
+    let (picture, physical) = {
+        let job = app.world().resource::<Job>();
+        (job.picture.clone(), job.physical.clone())
+    };
+    app.add_plugins(ScheduleRunnerPlugin::run_loop(Duration::ZERO))
+        .add_systems(Update, (capture, finish).chain().after(count_ready_frames))
         .run();
     let job = app.world_mut().remove_resource::<Job>();
     if let Some(failure) = job.and_then(|j| j.failure) {
@@ -160,7 +177,10 @@ pub fn render(request: OffscreenRequest) -> Result<RenderedImage, String> {
     let physical = physical.lock().expect("offscreen physical lock").take();
     let pixels = (request.width * request.height) as usize;
     match (rgba, physical) {
-        (Some(rgba), Some(physical)) if rgba.len() == 4 * pixels && physical.len() == pixels => {
+        (Some(mut rgba), Some(physical)) if rgba.len() == 4 * pixels && physical.len() == pixels => {
+            if request.settings.mode == RenderMode::FalseColour {
+                super::legend::draw_legend(&mut rgba, request.width, request.height, request.settings.false_colour_max_lux);
+            }
             Ok(RenderedImage { width: request.width, height: request.height, rgba, physical })
         }
         (Some(_), Some(_)) => Err("cannot read back the rendered image: unexpected size or format".into()),
@@ -211,19 +231,16 @@ fn light_ready(mode: RenderMode, lighting: Option<&LightingState>, sun_pass: &Su
     }
 }
 
-fn capture(
-    mut commands: Commands,
-    mut job: ResMut<Job>,
-    lighting: Option<Res<LightingState>>,
-    sun_pass: Res<SunPassInput>,
-    sun_sky: Option<Res<SunSky>>,
-) {
-    let Some([picture, physical]) = job.targets.clone() else { return };
-    if !light_ready(job.request.settings.mode, lighting.as_deref(), &sun_pass, sun_sky.as_deref()) {
+fn count_ready_frames(mut job: ResMut<Job>, lighting: Option<Res<LightingState>>, sun_pass: Res<SunPassInput>, sun_sky: Option<Res<SunSky>>) {
+    if job.targets.is_some() && light_ready(job.request.settings.mode, lighting.as_deref(), &sun_pass, sun_sky.as_deref()) {
+        job.frames_drawn += 1;
+    } else {
         job.frames_drawn = 0;
-        return;
     }
-    job.frames_drawn += 1;
+}
+
+fn capture(mut commands: Commands, mut job: ResMut<Job>) {
+    let Some([picture, physical]) = job.targets.clone() else { return };
     if job.frames_drawn < WARM_UP_FRAMES || job.capture_requested {
         return;
     }

@@ -65,8 +65,9 @@ pub struct SunLight {
     pub direction: Vec3,
     /// Irradiance normal to `direction` after the window, W/m².
     pub irradiance: f32,
-    /// The window it passes ([`Scene::windows`] index); `None`: light that
-    /// meets no surface at all on its way (the outside of the model).
+    /// The aperture it passes (index into [`SunPassFrame::windows`]);
+    /// `None`: light that meets no surface at all on its way (the outside
+    /// of the model).
     pub window: Option<usize>,
 }
 
@@ -81,6 +82,8 @@ pub struct SunPassFrame {
     pub volumes: Vec<Vec4>,
     pub opaque_caps: Range<u32>,
     pub opaque_sides: Range<u32>,
+    /// Volume of each aperture: the windows of one material that face one
+    /// way (their light shares a transmittance).
     pub windows: Vec<Range<u32>>,
     pub lights: Vec<SunLight>,
 }
@@ -108,16 +111,29 @@ impl SunPassFrame {
         let opaque_sides = opaque_caps.end..opaque_caps.end + opaque.sides.len() as u32;
         let mut volumes = opaque.caps;
         volumes.extend(opaque.sides);
-        let mut windows = Vec::with_capacity(scene.windows.len());
+        // Windows of one material facing one way pass the sun alike: one
+        // aperture, one pass.
+        let mut apertures: Vec<((u32, [i32; 3]), Vec<[Vec3; 3]>, Vec3)> = Vec::new();
+        for window in &scene.windows {
+            let key = (window.material, window.normal.to_array().map(|c| (c * 1e4).round() as i32));
+            let index = match apertures.iter().position(|a| a.0 == key) {
+                Some(index) => index,
+                None => {
+                    apertures.push((key, Vec::new(), window.normal));
+                    apertures.len() - 1
+                }
+            };
+            apertures[index].1.extend(surface_triangles(window.surface));
+        }
+        let mut windows = Vec::with_capacity(apertures.len());
         let mut lights = Vec::new();
-        for (index, window) in scene.windows.iter().enumerate() {
+        for (index, ((material, _), panes, normal)) in apertures.into_iter().enumerate() {
             let start = volumes.len() as u32;
-            let panes: Vec<[Vec3; 3]> = surface_triangles(window.surface).collect();
             let volume = shadow_volume(&panes, to_sun);
             volumes.extend(volume.caps.into_iter().chain(volume.sides));
             windows.push(start..volumes.len() as u32);
-            let cos = f64::from(window.normal.dot(to_sun));
-            let transmittance = match &scene.materials[window.material as usize].kind {
+            let cos = f64::from(normal.dot(to_sun));
+            let transmittance = match &scene.materials[material as usize].kind {
                 MaterialKind::Glass { transmittance } => Glass::from_transmittance(f64::from(*transmittance)).at(cos).0,
                 // Panels pass light straight through until panel models arrive.
                 _ => 1.0,

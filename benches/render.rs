@@ -1,0 +1,121 @@
+//! Frame time of the hybrid renderer, headless on whatever Vulkan device
+//! there is (Mesa's lavapipe on the CI machines): the bundled scenes in full
+//! mode, and a generated hall of 100k triangles with direct sun only (its
+//! sky and indirect light are one vertex-coloured mesh draw; the stencil
+//! passes are what grows with the model). Prints the passes and shadow-volume
+//! triangles drawn per frame.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use bevy::prelude::*;
+use criterion::{Criterion, criterion_group, criterion_main};
+use heliodon::render::offscreen::{OffscreenRequest, frame_ready, offscreen_app};
+use heliodon::render::sun_pass::SunPassInput;
+use heliodon::render::{RenderMode, RenderSettings};
+use heliodon::sky::SkySpec;
+use heliodon::time::{Date, LocalDateTime, TimeOfDay};
+
+const WIDTH: u32 = 1280;
+const HEIGHT: u32 = 720;
+
+/// A 60 × 40 m hall with a glazed south façade and 8,400 boxes (desks,
+/// cabinets) on its floor: about 100k triangles.
+fn hall(dir: &Path) -> PathBuf {
+    let mut obj = String::from("mtllib model.mtl\n");
+    let mut vertices = 0;
+    let mut quad = |obj: &mut String, material: &str, p: [[f64; 3]; 4]| {
+        let _ = writeln!(obj, "usemtl {material}");
+        for v in p {
+            let _ = writeln!(obj, "v {} {} {}", v[0], v[1], v[2]);
+        }
+        let _ = writeln!(obj, "f {} {} {} {}", vertices + 1, vertices + 2, vertices + 3, vertices + 4);
+        vertices += 4;
+    };
+    let (w, d, h) = (60.0, 40.0, 4.0);
+    quad(&mut obj, "floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
+    quad(&mut obj, "ceiling", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
+    quad(&mut obj, "wall", [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]]);
+    quad(&mut obj, "wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
+    quad(&mut obj, "wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
+    quad(&mut obj, "wall", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, 0.0, 1.0], [0.0, 0.0, 1.0]]);
+    quad(&mut obj, "wall", [[0.0, 0.0, 3.0], [w, 0.0, 3.0], [w, 0.0, h], [0.0, 0.0, h]]);
+    quad(&mut obj, "glass", [[0.0, 0.0, 1.0], [w, 0.0, 1.0], [w, 0.0, 3.0], [0.0, 0.0, 3.0]]);
+    for i in 0..120 {
+        for j in 0..70 {
+            let (x, y) = (0.5 + 0.49 * f64::from(i), 2.0 + 0.54 * f64::from(j));
+            let (a, b, top) = ([x, y], [x + 0.3, y + 0.3], 0.5 + 0.25 * f64::from((i + j) % 3));
+            let c = |p: [f64; 2], z: f64| [p[0], p[1], z];
+            let (p00, p10, p11, p01) = ([a[0], a[1]], [b[0], a[1]], [b[0], b[1]], [a[0], b[1]]);
+            quad(&mut obj, "box", [c(p00, top), c(p10, top), c(p11, top), c(p01, top)]);
+            quad(&mut obj, "box", [c(p00, 0.0), c(p10, 0.0), c(p10, top), c(p00, top)]);
+            quad(&mut obj, "box", [c(p10, 0.0), c(p11, 0.0), c(p11, top), c(p10, top)]);
+            quad(&mut obj, "box", [c(p11, 0.0), c(p01, 0.0), c(p01, top), c(p11, top)]);
+            quad(&mut obj, "box", [c(p01, 0.0), c(p00, 0.0), c(p00, top), c(p01, top)]);
+            quad(&mut obj, "box", [c(p00, 0.0), c(p01, 0.0), c(p11, 0.0), c(p10, 0.0)]);
+        }
+    }
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(dir.join("model.obj"), obj).unwrap();
+    std::fs::write(
+        dir.join("model.mtl"),
+        "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl ceiling\nKd 0.8 0.8 0.8\nnewmtl wall\nKd 0.6 0.6 0.6\nnewmtl box\nKd 0.5 0.45 0.4\nnewmtl glass\nd 0.7\n",
+    )
+    .unwrap();
+    let scene = "name = \"Hall of boxes\"\n[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n[model]\nobj = \"model.obj\"\n[lighting]\npatch_size = 4.0\n\n[[cameras]]\nname = \"hall\"\neye = [5.0, 38.0, 3.5]\ntarget = [35.0, 5.0, 0.0]\nfov = 60.0\n";
+    std::fs::write(dir.join("scene.toml"), scene).unwrap();
+    dir.join("scene.toml")
+}
+
+/// A warmed-up app drawing `scene`'s first camera, and what the sun pass draws per frame.
+fn ready_app(scene: PathBuf, mode: RenderMode) -> (App, String) {
+    let request = OffscreenRequest {
+        scene,
+        view: None,
+        width: WIDTH,
+        height: HEIGHT,
+        when: Some(LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(10.0).unwrap() }),
+        sky: Some(SkySpec::Clear { turbidity: 2.45 }),
+        settings: RenderSettings { mode, ..Default::default() },
+    };
+    let mut app = offscreen_app(&request);
+    app.finish();
+    app.cleanup();
+    while !frame_ready(&app) {
+        app.update();
+    }
+    let counts = match &app.world().resource::<SunPassInput>().0 {
+        Some(frame) => {
+            let window_lights = frame.lights.iter().filter(|l| l.window.is_some()).count();
+            // Depth copy, opaque caps and sides; per aperture: volume, light, volume; outside: volumes, light.
+            let draws = 3 + 3 * window_lights + 2;
+            format!(
+                "{draws} draws per frame ({} lights), {} shadow-volume triangles, {} lit triangles drawn {} times",
+                frame.lights.len(),
+                frame.volumes.len() / 3,
+                frame.lit.len() / 27,
+                frame.lights.len()
+            )
+        }
+        None => "no sun pass".into(),
+    };
+    (app, counts)
+}
+
+fn bench(c: &mut Criterion) {
+    let mut group = c.benchmark_group("render");
+    group.sample_size(10).measurement_time(Duration::from_secs(15));
+    let mut cases: Vec<(String, PathBuf, RenderMode)> =
+        heliodon::BUNDLED_SCENES.iter().map(|name| (format!("{name} full"), heliodon::bundled_scene(name), RenderMode::Full)).collect();
+    cases.push(("hall 100k triangles sun".into(), hall(&std::env::temp_dir().join("heliodon-bench-hall")), RenderMode::Sun));
+    for (label, scene, mode) in cases {
+        let (mut app, counts) = ready_app(scene, mode);
+        println!("{label}: {counts}");
+        group.bench_function(format!("frame {label} {WIDTH}x{HEIGHT}"), |b| b.iter(|| app.update()));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
