@@ -9,7 +9,8 @@ use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use heliodon::light::{LightModel, LightSettings, Lighting};
-use heliodon::scene::{PanelNames, Scene, load_scene};
+use heliodon::panel::PanelCatalog;
+use heliodon::scene::{Scene, load_scene};
 use heliodon::sky::{Sky, SkySpec};
 use heliodon::sun::solar_position;
 use heliodon::time::{Date, LocalDateTime, TimeOfDay};
@@ -90,7 +91,7 @@ fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("light");
     group.sample_size(10).measurement_time(Duration::from_secs(20));
     for name in heliodon::BUNDLED_SCENES {
-        let scene = Arc::new(load_scene(&heliodon::bundled_scene(name), &PanelNames::new()).unwrap().scene);
+        let scene = Arc::new(load_scene(&heliodon::bundled_scene(name), &PanelCatalog::new()).unwrap().scene);
         group.bench_function(format!("precompute {name} ({} patches)", scene.patches.patches.len()), |b| {
             b.iter(|| LightModel::precompute(scene.clone(), LightSettings::default()).unwrap())
         });
@@ -99,7 +100,7 @@ fn bench(c: &mut Criterion) {
         group.bench_function(format!("relight {name} (sun moves 10 min)"), |b| b.iter(|| relight(&model, &scene, &before, 10.0 + 1.0 / 6.0)));
     }
     let path = large_building(&std::env::temp_dir().join("heliodon-bench-office-floor"));
-    let scene = Arc::new(load_scene(&path, &PanelNames::new()).unwrap().scene);
+    let scene = Arc::new(load_scene(&path, &PanelCatalog::new()).unwrap().scene);
     let patches = scene.patches.patches.len();
     let start = Instant::now();
     let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();

@@ -8,7 +8,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::ecs::PanelRegistry;
+use crate::ecs::{AddPanels, panel_catalog};
+use crate::panel::PanelCatalog;
 use crate::render::offscreen::OffscreenRequest;
 use crate::render::{RenderMode, RenderSettings};
 use crate::scene::{self, DEFAULT_FOV, MaterialKind, Scene, Viewpoint};
@@ -237,7 +238,10 @@ fn in_range(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone {
 }
 
 /// Parses the command line and runs it.
-pub fn main() -> ExitCode {
+/// Runs the command line; `add_panels` adds the panel plugins to every app
+/// it makes, and the scene loader knows the panels they register.
+pub fn main(add_panels: AddPanels) -> ExitCode {
+    let panels = panel_catalog(add_panels);
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(error) => {
@@ -261,11 +265,11 @@ pub fn main() -> ExitCode {
         }
     };
     match cli.command {
-        None => crate::viewer::run(cli.scene.unwrap_or_else(|| crate::bundled_scene(crate::DEFAULT_SCENE))),
+        None => crate::viewer::run(cli.scene.unwrap_or_else(|| crate::bundled_scene(crate::DEFAULT_SCENE)), add_panels),
         Some(Command::View { scene }) => {
-            crate::viewer::run(scene.unwrap_or_else(|| crate::bundled_scene(crate::DEFAULT_SCENE)))
+            crate::viewer::run(scene.unwrap_or_else(|| crate::bundled_scene(crate::DEFAULT_SCENE)), add_panels)
         }
-        Some(Command::Info { scene }) => match scene::load_scene(&scene, &PanelRegistry::default().names()) {
+        Some(Command::Info { scene }) => match scene::load_scene(&scene, &panels) {
             Ok(loaded) => {
                 for warning in &loaded.warnings {
                     eprintln!("warning: {warning}");
@@ -278,7 +282,7 @@ pub fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         },
-        Some(Command::Sensors(args)) => match sensors(&args) {
+        Some(Command::Sensors(args)) => match sensors(&args, &panels) {
             Ok(text) => {
                 print!("{text}");
                 ExitCode::SUCCESS
@@ -288,14 +292,14 @@ pub fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         },
-        Some(Command::ExportRadiance(args)) => match export_radiance(&args) {
+        Some(Command::ExportRadiance(args)) => match export_radiance(&args, &panels) {
             Ok(()) => ExitCode::SUCCESS,
             Err(error) => {
                 eprintln!("error: {error}");
                 ExitCode::FAILURE
             }
         },
-        Some(Command::Render(args)) => match render(&args) {
+        Some(Command::Render(args)) => match render(&args, add_panels) {
             Ok(()) => ExitCode::SUCCESS,
             Err(error) => {
                 eprintln!("error: {error}");
@@ -318,8 +322,8 @@ fn progress_bar(fraction: f64) {
 }
 
 /// Loads a scene for a command, printing its warnings.
-fn load_for_command(path: &std::path::Path) -> Result<Scene, String> {
-    let loaded = scene::load_scene(path, &PanelRegistry::default().names()).map_err(|e| e.to_string())?;
+fn load_for_command(path: &std::path::Path, panels: &PanelCatalog) -> Result<Scene, String> {
+    let loaded = scene::load_scene(path, panels).map_err(|e| e.to_string())?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
@@ -335,9 +339,9 @@ fn sky_for(scene: &Scene, spec: &SkySpec, sky_name: &str, when: LocalDateTime) -
 }
 
 /// The `export-radiance` command.
-pub fn export_radiance(args: &ExportArgs) -> Result<(), String> {
+pub fn export_radiance(args: &ExportArgs, panels: &PanelCatalog) -> Result<(), String> {
     let spec = args.sky.spec()?;
-    let scene = load_for_command(&args.scene)?;
+    let scene = load_for_command(&args.scene, panels)?;
     let when = LocalDateTime { date: args.date, time: args.time };
     let (position, sky) = sky_for(&scene, &spec, &args.sky.sky, when)?;
     let case = format!(
@@ -348,9 +352,9 @@ pub fn export_radiance(args: &ExportArgs) -> Result<(), String> {
 }
 
 /// The `render` command.
-pub fn render(args: &RenderArgs) -> Result<(), String> {
+pub fn render(args: &RenderArgs, add_panels: AddPanels) -> Result<(), String> {
     let sky = args.sky.spec()?;
-    let scene = load_for_command(&args.scene)?;
+    let scene = load_for_command(&args.scene, &panel_catalog(add_panels))?;
     let mut view = match &args.camera {
         Some(name) => Some(scene.viewpoints.iter().find(|v| &v.name == name).cloned().ok_or_else(|| {
             let known: Vec<&str> = scene.viewpoints.iter().map(|v| v.name.as_str()).collect();
@@ -373,6 +377,7 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
         when: Some(LocalDateTime { date: args.date, time: args.time }),
         sky: Some(sky),
         settings: RenderSettings { mode: args.mode, exposure: args.exposure.map(|e| e as f32), ..Default::default() },
+        add_panels,
     })?;
     image.save_png(&args.out)?;
     match &args.hdr {
@@ -382,9 +387,9 @@ pub fn render(args: &RenderArgs) -> Result<(), String> {
 }
 
 /// The `sensors` command: one precomputation, then every date × time.
-pub fn sensors(args: &SensorsArgs) -> Result<String, String> {
+pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, String> {
     let spec = args.sky.spec()?;
-    let scene = std::sync::Arc::new(load_for_command(&args.scene)?);
+    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels)?);
     let cache_dir = if args.no_cache { None } else { cache::default_dir() };
     let (model, _) = cache::precompute_cached(scene.clone(), LightSettings::default(), cache_dir.as_deref(), &progress_bar)?;
     if std::io::stderr().is_terminal() {

@@ -2,7 +2,7 @@
 //!
 //! Layers, from the bottom (see ARCHITECTURE.md):
 //! - science, plain Rust without Bevy types: [`site`], [`time`], [`scene`],
-//!   [`sun`], [`sky`], [`light`];
+//!   [`sun`], [`sky`], [`light`], [`panel`] (the panel API);
 //! - the ECS layer: [`ecs`] ([`HeliodonPlugins`], runs headless);
 //! - drawing: [`render`]; the window and its input: [`viewer`];
 //! - the command line: [`cli`]; Radiance export: [`radiance`].
@@ -10,6 +10,7 @@
 pub mod cli;
 pub mod ecs;
 pub mod light;
+pub mod panel;
 pub mod radiance;
 pub mod render;
 pub mod scene;
@@ -24,6 +25,9 @@ use std::path::{Path, PathBuf};
 use bevy::asset::{AssetMetaCheck, AssetPlugin, UnapprovedPathMode};
 
 pub use ecs::HeliodonPlugins;
+/// The Bevy and glam heliodon is built on, for panel plugins (one version for all).
+pub use bevy;
+pub use glam;
 
 /// The `AssetPlugin` heliodon apps need: scene files are opened by absolute
 /// path wherever they are, and carry no `.meta` files.

@@ -2,18 +2,21 @@
 //! copied from ../shared/validation into tests/fixtures/sideroom), and its
 //! physical and numerical promises.
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use heliodon::light::{LightModel, LightSettings};
-use heliodon::scene::{PanelNames, Scene, load_scene};
+use heliodon::panel::PanelCatalog;
+use heliodon::scene::{Scene, load_scene};
 use heliodon::sky::{Sky, SkySpec, integrate_hemisphere};
 use heliodon::sun::solar_position;
 use heliodon::time::{Date, LocalDateTime, TimeOfDay};
 
 fn load(path: &Path) -> Arc<Scene> {
-    Arc::new(load_scene(path, &PanelNames::new()).unwrap().scene)
+    Arc::new(load_scene(path, &PanelCatalog::new()).unwrap().scene)
 }
 
 fn sideroom() -> PathBuf {
@@ -215,7 +218,7 @@ fn the_cache_is_used_and_never_trusted_when_damaged() {
 // ---- the sensors command -------------------------------------------------------------
 
 fn heliodon(args: &[&str], cache: &Path) -> (i32, String, String) {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_heliodon"))
+    let out = std::process::Command::new(common::heliodon_exe())
         .args(args)
         .env("HELIODON_CACHE_DIR", cache)
         .output()
@@ -289,7 +292,7 @@ fn export_radiance_writes_the_same_model_and_sky() {
     let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("export_test_room");
     let _ = std::fs::remove_dir_all(&out);
     let scene_path = heliodon::bundled_scene("test_room");
-    let status = std::process::Command::new(env!("CARGO_BIN_EXE_heliodon"))
+    let status = std::process::Command::new(common::heliodon_exe())
         .args(["export-radiance", scene_path.to_str().unwrap(), "--date", "2026-03-21", "--time", "10:00", "--sky", "clear", "--out", out.to_str().unwrap()])
         .status()
         .unwrap();

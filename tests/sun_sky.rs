@@ -2,6 +2,8 @@
 //! (tests/fixtures/spa_pvlib.csv, made by tools/make_spa_fixture.py), and the
 //! gensky/gendaylit vectors of ../shared/reference/skies.md.
 
+mod common;
+
 use std::f64::consts::PI;
 
 use heliodon::site::Site;
@@ -310,7 +312,7 @@ fn bad_sky_input_is_one_clear_line() {
 // ---- command line -----------------------------------------------------------------------
 
 fn heliodon(args: &[&str]) -> (i32, String, String) {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_heliodon")).args(args).output().expect("run heliodon");
+    let out = std::process::Command::new(common::heliodon_exe()).args(args).output().expect("run heliodon");
     (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
 }
 

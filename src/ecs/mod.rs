@@ -12,7 +12,7 @@ mod sun_sky;
 use bevy::app::PluginGroupBuilder;
 use bevy::prelude::*;
 
-pub use scene_asset::{PanelRegistry, SceneAsset, SceneLoader, describe_load_failure, scene_asset_path};
+pub use scene_asset::{AddPanels, PanelRegistry, RegisterPanel, SceneAsset, panel_catalog, SceneLoader, describe_load_failure, scene_asset_path};
 pub use scene_plugin::{
     ActiveScene, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, ScenePlugin, SceneRoot, SceneSpawned,
     SceneSurface, SceneSensor, SceneWindow, Site,

@@ -9,7 +9,8 @@ use bevy::asset::io::{AssetReaderError, Reader};
 use bevy::asset::{AssetLoadError, AssetLoader, AssetPath, LoadContext};
 use bevy::prelude::*;
 
-use crate::scene::{self, PanelNames, Scene, SceneError, SceneReader, SceneWarning};
+use crate::panel::{PanelCatalog, PanelType};
+use crate::scene::{self, Scene, SceneError, SceneReader, SceneWarning};
 
 /// A loaded scene file with its warnings.
 #[derive(Asset, TypePath, Debug, Clone)]
@@ -18,20 +19,45 @@ pub struct SceneAsset {
     pub warnings: Vec<SceneWarning>,
 }
 
-/// Names of the panel models plugins have registered. Shared with the scene
+/// The panel types plugins have registered: what the scene loader, the
+/// engine, the renderer and the UI know by name. Shared with the scene
 /// loader, so a panel registered at any time before a load is known to it.
 #[derive(Resource, Clone, Default)]
 pub struct PanelRegistry {
-    names: Arc<RwLock<PanelNames>>,
+    catalog: Arc<RwLock<PanelCatalog>>,
 }
 
 impl PanelRegistry {
-    pub fn register(&self, name: impl Into<String>) {
-        self.names.write().expect("panel registry lock").insert(name.into());
+    pub fn register(&self, panel: impl PanelType + 'static) {
+        self.catalog.write().expect("panel registry lock").register(Arc::new(panel));
     }
 
-    pub fn names(&self) -> PanelNames {
-        self.names.read().expect("panel registry lock").clone()
+    /// A snapshot of the registered panel types.
+    pub fn catalog(&self) -> PanelCatalog {
+        self.catalog.read().expect("panel registry lock").clone()
+    }
+}
+
+/// Adds panel plugins to an app: how the command line hands the built-in
+/// panels (and any others) to every app it makes.
+pub type AddPanels = fn(&mut App);
+
+/// The panel types that `add_panels` registers.
+pub fn panel_catalog(add_panels: AddPanels) -> PanelCatalog {
+    let mut app = App::new();
+    add_panels(&mut app);
+    app.world_mut().get_resource_or_init::<PanelRegistry>().catalog()
+}
+
+/// Registering a panel type from a plugin: `app.register_panel(MyPanel)`.
+pub trait RegisterPanel {
+    fn register_panel(&mut self, panel: impl PanelType + 'static) -> &mut Self;
+}
+
+impl RegisterPanel for App {
+    fn register_panel(&mut self, panel: impl PanelType + 'static) -> &mut Self {
+        self.world_mut().get_resource_or_init::<PanelRegistry>().register(panel);
+        self
     }
 }
 
@@ -66,7 +92,7 @@ impl AssetLoader for SceneLoader {
             .await
             .map_err(|e| SceneError::new(scene::Location::file(&scene_path), format!("cannot read scene file: {e}")))?;
         let mut files = AssetFiles { context: load_context, first: Some((scene_path.clone(), scene_bytes)) };
-        let loaded = scene::load_scene_with(&scene_path, &self.panels.names(), &mut files).await?;
+        let loaded = scene::load_scene_with(&scene_path, &self.panels.catalog(), &mut files).await?;
         for warning in &loaded.warnings {
             warn!("{warning}");
         }

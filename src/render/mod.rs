@@ -173,7 +173,7 @@ fn update_sun_pass(
 /// (sun included, weighted by the solid angle they fill) is mapped to
 /// middle grey, 0.18 (EV100 = log2(1.2 · L / 0.18) in Bevy's terms). With
 /// direct sun alone, L is that of a mid-grey surface facing the sun.
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn auto_exposure(
     state: Option<Res<LightingState>>,
     engine: Option<Res<LightEngine>>,
@@ -235,7 +235,7 @@ fn metered_luminance(scene: &Scene, model: &LightModel, sides: &[Channels], came
         if model.trace(eye, direction).is_some_and(|(hit, t)| hit as usize != p && t < distance - 1e-3) {
             continue;
         }
-        let Some(channels) = sides.get(side_of(p as u32, back) as usize) else { return None };
+        let channels = sides.get(side_of(p as u32, back) as usize)?;
         let with_sun = Channels { sky: channels.sky + channels.sun, ..*channels };
         let [r, g, b] = side_value(&with_sun, reflectance.0, RenderMode::Full);
         let luminance = f64::from(0.265 * r + 0.670 * g + 0.065 * b);

@@ -44,6 +44,8 @@ pub struct OffscreenRequest {
     /// `None`: the app's default sky.
     pub sky: Option<SkySpec>,
     pub settings: RenderSettings,
+    /// Adds the panel plugins the scene may name.
+    pub add_panels: crate::ecs::AddPanels,
 }
 
 /// One rendered frame.
@@ -129,6 +131,7 @@ pub fn offscreen_app(request: &OffscreenRequest) -> App {
     } else {
         app.add_plugins(HeliodonPlugins);
     }
+    (request.add_panels)(&mut app);
     app.add_plugins(HeliodonRenderPlugin)
         .insert_resource(request.settings)
         .insert_resource(Job {

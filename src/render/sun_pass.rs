@@ -113,7 +113,8 @@ impl SunPassFrame {
         volumes.extend(opaque.sides);
         // Windows of one material facing one way pass the sun alike: one
         // aperture, one pass.
-        let mut apertures: Vec<((u32, [i32; 3]), Vec<[Vec3; 3]>, Vec3)> = Vec::new();
+        type ApertureKey = (u32, [i32; 3]);
+        let mut apertures: Vec<(ApertureKey, Vec<[Vec3; 3]>, Vec3)> = Vec::new();
         for window in &scene.windows {
             let key = (window.material, window.normal.to_array().map(|c| (c * 1e4).round() as i32));
             let index = match apertures.iter().position(|a| a.0 == key) {

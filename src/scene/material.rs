@@ -8,7 +8,7 @@ use toml::{Spanned, Value};
 use super::error::{Location, SceneError, SceneWarning};
 use super::file::{MaterialTable, ParsedScene};
 use super::obj::ObjModel;
-use super::PanelNames;
+use crate::panel::{PanelCatalog, PanelHandle, Parameters, base_dir as panel_base_dir};
 
 /// A colour triple (linear RGB); scalars are grey.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,8 +31,10 @@ pub enum MaterialKind {
         panel: String,
         /// The panel's in-plane orientation (canonical frame), when given.
         up: Option<Vec3>,
-        /// The panel's own keys, checked by the panel model.
+        /// The panel's own keys, as the scene file gives them.
         parameters: toml::Table,
+        /// The model built from them by the panel's type.
+        model: PanelHandle,
     },
 }
 
@@ -77,7 +79,7 @@ const UNASSIGNED_REFLECTANCE: f32 = 0.5;
 pub fn resolve(
     parsed: &ParsedScene,
     model: &ObjModel,
-    panels: &PanelNames,
+    panels: &PanelCatalog,
     obj_path: &std::path::Path,
     warnings: &mut Vec<SceneWarning>,
 ) -> Result<(Vec<Material>, BTreeMap<Option<usize>, u32>), SceneError> {
@@ -137,7 +139,7 @@ fn scene_material(
     parsed: &ParsedScene,
     name: &str,
     table: &Spanned<MaterialTable>,
-    panels: &PanelNames,
+    panels: &PanelCatalog,
 ) -> Result<Material, SceneError> {
     let key = |k: &str| format!("materials.{name}.{k}");
     let entries = table.get_ref();
@@ -192,11 +194,11 @@ fn scene_material(
             let Value::String(panel_name) = panel.get_ref() else {
                 return parsed.error(panel.span(), key("panel"), "must be a panel name (a string)");
             };
-            if !panels.contains(panel_name) {
+            if panels.get(panel_name).is_none() {
                 let registered = if panels.is_empty() {
                     "none".to_string()
                 } else {
-                    panels.iter().cloned().collect::<Vec<_>>().join(", ")
+                    panels.names().collect::<Vec<_>>().join(", ")
                 };
                 return parsed.error(
                     panel.span(),
@@ -208,12 +210,17 @@ fn scene_material(
                 Some(value) => Some(panel_up(parsed, value, &key("up"))?),
                 None => None,
             };
-            let parameters = entries
+            let parameters: toml::Table = entries
                 .iter()
                 .filter(|(k, _)| !matches!(k.as_str(), "kind" | "panel" | "up"))
                 .map(|(k, v)| (k.clone(), v.get_ref().clone()))
                 .collect();
-            MaterialKind::Panel { panel: panel_name.clone(), up, parameters }
+            let model = panels.build(panel_name, &Parameters::new(parameters.clone(), panel_base_dir(&parsed.path))).map_err(|e| {
+                // Point at the key, or at the material when the key is missing.
+                let span = entries.get(&e.key).map_or(table.span(), |v| v.span());
+                SceneError::new(parsed.at(span, key(&e.key)), e.message)
+            })?;
+            MaterialKind::Panel { panel: panel_name.clone(), up, parameters, model: PanelHandle(model) }
         }
     };
     Ok(Material {

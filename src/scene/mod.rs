@@ -15,7 +15,6 @@ mod patches;
 mod sensors;
 mod surfaces;
 
-use std::collections::BTreeSet;
 use std::future::Future;
 use std::io;
 use std::ops::Range;
@@ -29,6 +28,7 @@ pub use material::{Material, MaterialKind, MaterialOrigin, Rgb};
 pub use patches::{Patch, PatchMesh};
 pub use sensors::{DEFAULT_FOV, Sensor, Viewpoint};
 
+use crate::panel::PanelCatalog;
 use crate::site::Site;
 
 /// Default side of the largest lighting patch, in metres.
@@ -152,18 +152,16 @@ impl SceneReader for FsReader {
     }
 }
 
-/// What the loader knows about panels: the names registered by panel plugins.
-pub type PanelNames = BTreeSet<String>;
-
-/// Loads a scene file from disk.
-pub fn load_scene(path: &Path, panels: &PanelNames) -> Result<LoadedScene, SceneError> {
+/// Loads a scene file from disk; panel materials are built by the types in
+/// `panels`.
+pub fn load_scene(path: &Path, panels: &PanelCatalog) -> Result<LoadedScene, SceneError> {
     futures_lite::future::block_on(load_scene_with(path, panels, &mut FsReader))
 }
 
 /// Loads a scene file and everything it refers to through `reader`.
 pub async fn load_scene_with(
     scene_path: &Path,
-    panels: &PanelNames,
+    panels: &PanelCatalog,
     reader: &mut impl SceneReader,
 ) -> Result<LoadedScene, SceneError> {
     let scene_text = read_text(reader, scene_path, None).await?;
@@ -205,7 +203,7 @@ fn build(
     obj_text: &str,
     obj_scan: obj::ObjScan,
     mtls: Vec<(PathBuf, String)>,
-    panels: &PanelNames,
+    panels: &PanelCatalog,
 ) -> Result<LoadedScene, SceneError> {
     let mut warnings = Vec::new();
     let model = obj::import(&obj_path, obj_text, &obj_scan, &mtls)?;

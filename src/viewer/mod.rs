@@ -35,10 +35,10 @@ impl Plugin for ViewerPlugin {
 }
 
 /// Opens the window on a scene; returns when the window closes.
-pub fn run(scene: PathBuf) -> ExitCode {
+pub fn run(scene: PathBuf, add_panels: crate::ecs::AddPanels) -> ExitCode {
     let title = format!("heliodon — {}", scene.display());
-    let exit = App::new()
-        .add_plugins(
+    let mut app = App::new();
+    app.add_plugins(
             DefaultPlugins
                 .set(WindowPlugin {
                     primary_window: Some(Window { title, resolution: (1280, 800).into(), ..default() }),
@@ -46,8 +46,9 @@ pub fn run(scene: PathBuf) -> ExitCode {
                 })
                 .set(crate::asset_plugin()),
         )
-        .add_plugins((HeliodonPlugins, HeliodonRenderPlugin, ViewerPlugin { scene }))
-        .run();
+        .add_plugins((HeliodonPlugins, HeliodonRenderPlugin, ViewerPlugin { scene }));
+    add_panels(&mut app);
+    let exit = app.run();
     match exit {
         AppExit::Success => ExitCode::SUCCESS,
         AppExit::Error(code) => ExitCode::from(code.get()),

@@ -1,0 +1,50 @@
+//! A panel plugin used only by tests, written as a modder would: `panel =
+//! "grey_filter"` passes a share of the light straight through, unchanged
+//! in direction (`transmittance`, required, 0-1), and absorbs the rest.
+
+use std::sync::Arc;
+
+use heliodon::bevy::prelude::{App, Plugin};
+use heliodon::ecs::RegisterPanel;
+use heliodon::glam::DVec3;
+use heliodon::panel::{Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters};
+
+pub struct GreyFilterPlugin;
+
+impl Plugin for GreyFilterPlugin {
+    fn build(&self, app: &mut App) {
+        app.register_panel(GreyFilter);
+    }
+}
+
+pub struct GreyFilter;
+
+impl PanelType for GreyFilter {
+    fn name(&self) -> &str {
+        "grey_filter"
+    }
+
+    fn keys(&self) -> &[&str] {
+        &["transmittance"]
+    }
+
+    fn build(&self, parameters: &Parameters) -> Result<Arc<dyn PanelModel>, ParameterError> {
+        Ok(Arc::new(GreyFilterModel { transmittance: parameters.number("transmittance", None, (0.0, 1.0))? }))
+    }
+}
+
+#[derive(Debug)]
+pub struct GreyFilterModel {
+    transmittance: f64,
+}
+
+impl PanelModel for GreyFilterModel {
+    fn response(&self, incoming: DVec3) -> PanelResponse {
+        PanelResponse {
+            lobes: vec![Lobe { direction: incoming.normalize(), share: self.transmittance, width: 0.0 }],
+            diffuse_transmittance: 0.0,
+            diffuse_reflectance: 0.0,
+            absorbed: 1.0 - self.transmittance,
+        }
+    }
+}
