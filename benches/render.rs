@@ -87,18 +87,14 @@ fn ready_app(scene: PathBuf, mode: RenderMode) -> (App, String) {
         app.update();
     }
     let counts = match &app.world().resource::<SunPassInput>().0 {
-        Some(frame) => {
-            let window_lights = frame.lights.iter().filter(|l| l.window.is_some()).count();
-            // Depth copy, opaque caps and sides; per aperture: volume, light, volume; outside: volumes, light.
-            let draws = 3 + 3 * window_lights + 2;
-            format!(
-                "{draws} draws per frame ({} lights), {} shadow-volume triangles, {} lit triangles drawn {} times",
-                frame.lights.len(),
-                frame.volumes.len() / 3,
-                frame.lit.len() / 27,
-                frame.lights.len()
-            )
-        }
+        Some(frame) => format!(
+            "{} draws per frame ({} direction passes, {} lights), {} shadow-volume triangles, {} lit triangles drawn once per light",
+            frame.draw_count(),
+            frame.passes.len(),
+            frame.lights().count(),
+            frame.volumes.len() / 3,
+            frame.lit.len() / 27,
+        ),
         None => "no sun pass".into(),
     };
     (app, counts)

@@ -11,12 +11,12 @@ use heliodon::ecs::{
 };
 use std::sync::Arc;
 
-use glam::DVec3;
 use heliodon::light::LightModel;
 use heliodon::render::offscreen::{self, OffscreenRequest};
+use heliodon::render::reference::{self, SunComparison};
 use heliodon::render::{RenderMode, RenderSettings, initial_view};
 use heliodon::panel::PanelCatalog;
-use heliodon::scene::{MaterialKind, Scene, Viewpoint, load_scene};
+use heliodon::scene::{Scene, Viewpoint, load_scene};
 use heliodon::sky::{Sky, SkySpec};
 use heliodon::sun::solar_position;
 use heliodon::time::{Date, LocalDateTime, TimeOfDay};
@@ -238,106 +238,26 @@ fn relights_run_as_tasks_and_the_last_change_wins() {
     }
 }
 
-/// Pixel centres' rays of a perspective camera as Bevy draws it (vertical
-/// field of view, the model's z up), row by row from the top.
-fn camera_rays(view: &Viewpoint, width: u32, height: u32) -> Vec<DVec3> {
-    let forward = (view.target - view.eye).normalize().as_dvec3();
-    let right = forward.cross(DVec3::Z).normalize();
-    let up = right.cross(forward);
-    let tan = (f64::from(view.fov).to_radians() / 2.0).tan();
-    let aspect = f64::from(width) / f64::from(height);
-    (0..height)
-        .flat_map(|j| (0..width).map(move |i| (i, j)))
-        .map(|(i, j)| {
-            let x = (2.0 * (f64::from(i) + 0.5) / f64::from(width) - 1.0) * tan * aspect;
-            let y = (1.0 - 2.0 * (f64::from(j) + 0.5) / f64::from(height)) * tan;
-            (forward + right * x + up * y).normalize()
-        })
-        .collect()
-}
-
-/// How a direct-sun image (mode `sun`) agrees with the CPU reference.
-struct SunComparison {
-    /// Pixels whose ray meets a diffuse surface.
-    compared: usize,
-    /// Share of them that agree on lit or unlit.
-    agreement: f64,
-    /// Pixels lit in both.
-    lit: usize,
-    /// Share of those within 2% of the reference.
-    within: f64,
-    /// What was found, worst error included, for the messages.
-    summary: String,
-}
-
-/// Renders the direct sun of a view and compares it with a CPU ray tracer:
-/// each pixel's ray finds its surface, then a shadow ray from there toward
-/// the sun goes through glass (Radiance's transmittance) or meets an opaque
-/// surface. Pixels whose ray meets glass or nothing are not compared. The
-/// image and a map of disagreements (red: only the reference is lit, green:
-/// only the image) are written to the test's temporary folder.
-fn compare_direct_sun(path: &std::path::Path, view: &Viewpoint, date: &str, time: &str) -> SunComparison {
-    let (width, height) = (320u32, 200u32);
-    let scene = Arc::new(load_scene(path, &PanelCatalog::new()).unwrap().scene);
-    let model = LightModel::unlit(scene.clone());
-    let when = LocalDateTime { date: Date::parse(date).unwrap(), time: TimeOfDay::parse(time).unwrap() };
-    let position = solar_position(&scene.site, &when);
-    let sky = Sky::new(&SkySpec::Clear { turbidity: 2.45 }, position.altitude, position.azimuth, scene.site.ground_reflectance, when.date.day_of_year()).unwrap();
-    let sun = sky.sun.expect("the sun is up");
+/// Renders the direct sun of a view and compares it with the CPU reference
+/// (`render::reference`); the picture and its disagreement map go to the
+/// test's temporary folder.
+fn compare_direct_sun(path: &std::path::Path, view: &Viewpoint, date: &str, time: &str) -> (SunComparison, String) {
     let request = OffscreenRequest {
         scene: path.to_path_buf(),
         view: Some(view.clone()),
-        width,
-        height,
-        when: Some(when),
+        width: 320,
+        height: 200,
+        when: Some(LocalDateTime { date: Date::parse(date).unwrap(), time: TimeOfDay::parse(time).unwrap() }),
         sky: Some(SkySpec::Clear { turbidity: 2.45 }),
         settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
         add_panels: |_| {},
     };
-    let image = offscreen::render(request).expect("render");
     let scene_name = path.parent().and_then(|p| p.file_name()).unwrap().to_string_lossy();
     let file = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("sun_{scene_name}_{}_{}.png", view.name.replace(' ', "_"), time.replace(':', "")));
-    image.save_png(&file).unwrap();
-    let (mut compared, mut agree, mut lit, mut within) = (0usize, 0usize, 0usize, 0usize);
-    let mut worst: f64 = 0.0;
-    let mut disagreement = image::RgbImage::new(width, height);
-    let eye = view.eye.as_dvec3();
-    for (k, (ray, gpu)) in camera_rays(view, width, height).into_iter().zip(&image.physical).enumerate() {
-        let Some((patch, distance)) = model.trace(eye, ray) else { continue };
-        let patch = &scene.patches.patches[patch as usize];
-        let MaterialKind::Diffuse { reflectance } = &scene.materials[patch.material as usize].kind else { continue };
-        let mut normal = patch.normal.as_dvec3();
-        if normal.dot(ray) > 0.0 {
-            normal = -normal;
-        }
-        let irradiance = model.sun_irradiance(eye + ray * distance, normal, &sun);
-        let expected = f64::from(reflectance.0[1]) / std::f64::consts::PI * irradiance * 179.0;
-        let got = f64::from(gpu[1]);
-        compared += 1;
-        let (cpu_lit, gpu_lit) = (expected > 1.0, got > 1.0);
-        agree += usize::from(cpu_lit == gpu_lit);
-        let shade = if cpu_lit == gpu_lit { [40 + 80 * u8::from(cpu_lit); 3] } else if cpu_lit { [255, 0, 0] } else { [0, 255, 0] };
-        disagreement.put_pixel(k as u32 % width, k as u32 / width, image::Rgb(shade));
-        if cpu_lit && gpu_lit {
-            lit += 1;
-            let error = (got / expected - 1.0).abs();
-            within += usize::from(error <= 0.02);
-            worst = worst.max(error);
-        }
-    }
-    disagreement.save(file.with_extension("diff.png")).unwrap();
-    let agreement = agree as f64 / compared.max(1) as f64;
-    let within = within as f64 / lit.max(1) as f64;
-    let summary = format!(
-        "{scene_name} {} {date} {time}: {compared} pixels, lit/unlit agree {:.2}%, {lit} lit, {:.2}% within 2% (worst {:.1}%) -> {}",
-        view.name,
-        100.0 * agreement,
-        100.0 * within,
-        100.0 * worst,
-        file.display()
-    );
+    let result = reference::compare_direct_sun(&request, &file).expect("render and compare");
+    let summary = format!("{scene_name} {} {date} {time}: {result} -> {}", view.name, file.display());
     println!("{summary}");
-    SunComparison { compared, agreement, lit, within, summary }
+    (result, summary)
 }
 
 /// Every bundled scene from its first camera at two sun positions and from
@@ -350,10 +270,10 @@ fn direct_sun_images_agree_with_a_ray_traced_reference() {
         let overview = initial_view(&Scene { viewpoints: Vec::new(), ..scene.clone() });
         let cases = [(&scene.viewpoints[0], "2026-03-21", "10:00"), (&scene.viewpoints[0], "2026-11-10", "14:30"), (&overview, "2026-12-21", "12:00")];
         for (view, date, time) in cases {
-            let result = compare_direct_sun(&path, view, date, time);
-            assert!(result.compared > 320 * 200 / 10, "{}", result.summary);
-            assert!(result.lit > 200, "too few sunlit pixels to compare: {}", result.summary);
-            assert!(result.agreement >= 0.99 && result.within >= 0.99, "{}", result.summary);
+            let (result, summary) = compare_direct_sun(&path, view, date, time);
+            assert!(result.compared > 320 * 200 / 10, "{summary}");
+            assert!(result.lit > 200, "too few sunlit pixels to compare: {summary}");
+            assert!(result.agreement >= 0.99 && result.within >= 0.99, "{summary}");
         }
     }
 }
@@ -378,9 +298,9 @@ fn cameras_inside_a_sunbeam_and_inside_a_shadow_see_the_sun_right() {
     assert_eq!(model.sun_irradiance(in_shadow, sun.direction, &sun), 0.0, "the eye is in shadow");
     for (name, eye, target) in [("in beam", in_beam, floor_patch), ("in shadow", in_shadow, floor_patch)] {
         let view = Viewpoint { name: name.into(), eye: eye.as_vec3(), target: target.as_vec3(), fov: 75.0 };
-        let result = compare_direct_sun(&path, &view, "2026-03-21", "10:00");
-        assert!(result.lit > 1000, "the floor patch fills much of the view: {}", result.summary);
-        assert!(result.agreement >= 0.99 && result.within >= 0.99, "{}", result.summary);
+        let (result, summary) = compare_direct_sun(&path, &view, "2026-03-21", "10:00");
+        assert!(result.lit > 1000, "the floor patch fills much of the view: {summary}");
+        assert!(result.agreement >= 0.99 && result.within >= 0.99, "{summary}");
     }
 }
 
@@ -438,8 +358,8 @@ f 19 20 14 17
         Viewpoint { name: "low".into(), eye: glam::Vec3::new(5.0, -3.0, 1.2), target: glam::Vec3::new(1.0, 1.0, 0.7), fov: 70.0 },
     ];
     for (view, time) in views.iter().zip(["15:00", "10:00"]) {
-        let result = compare_direct_sun(&path, view, "2026-03-21", time);
-        assert!(result.lit > 1000, "{}", result.summary);
-        assert!(result.agreement >= 0.99 && result.within >= 0.99, "{}", result.summary);
+        let (result, summary) = compare_direct_sun(&path, view, "2026-03-21", time);
+        assert!(result.lit > 1000, "{summary}");
+        assert!(result.agreement >= 0.99 && result.within >= 0.99, "{summary}");
     }
 }

@@ -19,6 +19,7 @@
 mod bvh;
 pub mod cache;
 mod glass;
+pub mod panels;
 mod sampling;
 
 use std::f64::consts::PI;
@@ -27,6 +28,7 @@ use std::sync::Arc;
 use glam::DVec3;
 
 pub use glass::Glass;
+pub use panels::{PanelFrame, SunBeam};
 
 use crate::scene::{MaterialKind, Scene, Sensor};
 use crate::sky::{LUMINOUS_EFFICACY, Sky, SkyPatches};
@@ -172,8 +174,10 @@ pub fn side_of(patch: u32, back: bool) -> u32 {
 enum Surface {
     Diffuse([f64; 3]),
     Glass(Glass),
-    /// A panel: plain pass-through until panel models arrive.
-    PassThrough,
+    /// A panel window of this group: the sun passes only along its lobes;
+    /// sky light still passes straight through (the sky transfer of panels
+    /// is not modelled yet).
+    Panel(u32),
 }
 
 /// Precomputed light transport for one scene.
@@ -185,6 +189,9 @@ pub struct LightModel {
     surfaces: Vec<Surface>,
     /// Per scene surface: its index in [`Scene::windows`], if it is one.
     window_of_surface: Vec<Option<u32>>,
+    /// Panel windows by material and orientation, and each surface's group.
+    panel_groups: Vec<panels::PanelGroup>,
+    group_of_surface: Vec<Option<u32>>,
     /// Per patch side (2 per patch; empty for glass and panels).
     side_gathers: Vec<Gather>,
     sensors: Vec<SensorGeometry>,
@@ -300,14 +307,11 @@ impl LightModel {
         self.tracer.closest(origin, direction, 1e-6).map(|hit| (hit.patch, hit.distance))
     }
 
-    /// Direct sun irradiance (W/m²) at `point` on a surface whose side
-    /// facing the light of interest has `normal`: shadow ray through glass.
+    /// Direct sun irradiance (W/m²) at `point` on a surface side with
+    /// `normal`: shadow rays through glass toward the sun, and through panel
+    /// windows along their lobes.
     pub fn sun_irradiance(&self, point: DVec3, normal: DVec3, sun: &crate::sky::SunSource) -> f64 {
-        let cos = normal.dot(sun.direction);
-        if cos <= 0.0 || sun.direction.z <= 0.0 {
-            return 0.0;
-        }
-        sun.normal_irradiance() * cos * self.sun_transmittance(point + normal * SURFACE_OFFSET, sun.direction)
+        self.beams_irradiance(point, normal, &self.sun_beams(sun))
     }
 
     /// The model with its tracer and materials but nothing gathered yet.
@@ -319,9 +323,11 @@ impl LightModel {
             .map(|m| match &m.kind {
                 MaterialKind::Diffuse { reflectance } => Surface::Diffuse(reflectance.0.map(f64::from)),
                 MaterialKind::Glass { transmittance } => Surface::Glass(Glass::from_transmittance(f64::from(*transmittance))),
-                MaterialKind::Panel { .. } => Surface::PassThrough,
+                // The group is the surface's: see `surface_of_patch`.
+                MaterialKind::Panel { .. } => Surface::Panel(u32::MAX),
             })
             .collect();
+        let (panel_groups, group_of_surface) = panels::panel_groups(&scene, &tracer);
         let mut window_of_surface = vec![None; scene.surfaces.len()];
         for (k, window) in scene.windows.iter().enumerate() {
             window_of_surface[window.surface as usize] = Some(k as u32);
@@ -329,6 +335,8 @@ impl LightModel {
         Self {
             bins: SkyPatches::reinhart(settings.sky_subdivision),
             window_of_surface,
+            panel_groups,
+            group_of_surface,
             scene,
             settings,
             tracer,
@@ -375,7 +383,11 @@ impl LightModel {
     }
 
     fn surface_of_patch(&self, patch: u32) -> Surface {
-        self.surfaces[self.scene.patches.patches[patch as usize].material as usize]
+        let patch = &self.scene.patches.patches[patch as usize];
+        match self.group_of_surface[patch.surface as usize] {
+            Some(group) => Surface::Panel(group),
+            None => self.surfaces[patch.material as usize],
+        }
     }
 
     fn patch_normal(&self, patch: u32) -> DVec3 {
@@ -400,7 +412,7 @@ impl LightModel {
                 let crossed = window.or(self.window_of_surface[self.scene.patches.patches[hit.patch as usize].surface as usize]);
                 match self.surface_of_patch(hit.patch) {
                     Surface::Diffuse(_) => sides.push(SideHit { side: side_of(hit.patch, cos > 0.0), weight, point }),
-                    Surface::PassThrough if depth < MAX_GLASS_DEPTH => {
+                    Surface::Panel(_) if depth < MAX_GLASS_DEPTH => {
                         self.follow(point + dir * SURFACE_OFFSET, dir, weight, depth + 1, crossed, bins, sides)
                     }
                     Surface::Glass(glass) if depth < MAX_GLASS_DEPTH => {
@@ -429,8 +441,9 @@ impl LightModel {
         let mut crossed: Vec<(u32, f64)> = Vec::new();
         self.tracer.each_hit(point, sun, 1e-6, |hit| {
             let patch = &self.scene.patches.patches[hit.patch as usize];
-            match self.surfaces[patch.material as usize] {
-                Surface::Diffuse(_) => {
+            match self.surface_of_patch(hit.patch) {
+                // Through a panel the sun arrives only along its lobes.
+                Surface::Diffuse(_) | Surface::Panel(_) => {
                     transmittance = 0.0;
                     false
                 }
@@ -441,10 +454,61 @@ impl LightModel {
                     }
                     true
                 }
-                Surface::PassThrough => true,
             }
         });
         transmittance
+    }
+
+    /// How much of a panel lobe's light reaches `point` from `to_light`:
+    /// the ray must leave through a window of the lobe's panel group (glass
+    /// on the way counts), and from there the real sun must reach it.
+    fn lobe_transmittance(&self, point: DVec3, to_light: DVec3, group: u32, sun: DVec3) -> f64 {
+        let (mut origin, mut transmittance) = (point, 1.0);
+        for _ in 0..=MAX_GLASS_DEPTH {
+            let Some(hit) = self.tracer.closest(origin, to_light, 1e-6) else { return 0.0 };
+            let at = origin + to_light * hit.distance;
+            match self.surface_of_patch(hit.patch) {
+                Surface::Panel(g) if g == group => return transmittance * self.sun_transmittance(at + sun * SURFACE_OFFSET, sun),
+                Surface::Glass(glass) => transmittance *= glass.at(to_light.dot(self.patch_normal(hit.patch))).0,
+                _ => return 0.0,
+            }
+            origin = at + to_light * SURFACE_OFFSET;
+        }
+        0.0
+    }
+
+    /// The beams of direct sunlight for a sun: itself and its panel lobes.
+    pub fn sun_beams(&self, sun: &crate::sky::SunSource) -> Vec<SunBeam> {
+        if sun.direction.z <= 0.0 {
+            return Vec::new();
+        }
+        panels::sun_beams(&self.panel_groups, sun)
+    }
+
+    /// Which panel group a surface's windows belong to.
+    pub fn panel_group_of_surface(&self, surface: u32) -> Option<u32> {
+        self.group_of_surface[surface as usize]
+    }
+
+    /// Direct sun irradiance (W/m²) from all `beams` at `point` on a surface
+    /// side with `normal`.
+    fn beams_irradiance(&self, point: DVec3, normal: DVec3, beams: &[SunBeam]) -> f64 {
+        let sun = beams.first().map_or(DVec3::Z, |b| b.to_light);
+        let origin = point + normal * SURFACE_OFFSET;
+        beams
+            .iter()
+            .map(|beam| {
+                let cos = normal.dot(beam.to_light);
+                if cos <= 0.0 {
+                    return 0.0;
+                }
+                let reach = match beam.panel_group {
+                    None => self.sun_transmittance(origin, beam.to_light),
+                    Some(group) => self.lobe_transmittance(origin, beam.to_light, group, sun),
+                };
+                beam.normal_irradiance * cos * reach
+            })
+            .sum()
     }
 
     fn gather_patch_side(&self, side: usize) -> Gather {
@@ -517,6 +581,7 @@ impl LightModel {
         let bin_count = self.bin_count();
         let sky_irradiance = |g: &Gather| PI * g.bins.iter().map(|&(k, w)| f64::from(w) * bin_radiance[(k % bin_count) as usize]).sum::<f64>();
         let sun = sky.sun.filter(|s| s.direction.z > 0.0);
+        let beams = sun.map(|s| self.sun_beams(&s)).unwrap_or_default();
         let direct: Vec<Channels> = par_map(self.settings.threads, patches.len() * 2, |side| {
             let gather = &self.side_gathers[side];
             let patch = &patches[side / 2];
@@ -525,17 +590,12 @@ impl LightModel {
             }
             let normal = patch.normal.as_dvec3() * if side % 2 == 1 { -1.0 } else { 1.0 };
             let mut channels = Channels { sky: sky_irradiance(gather), ..Default::default() };
-            if let Some(sun) = sun {
-                let cos = normal.dot(sun.direction);
-                if cos > 0.0 {
-                    let triangles = self.patch_triangles(side / 2);
-                    let mut rng = Rng::new(3, side as u64);
-                    let n = self.settings.sun_samples_per_patch;
-                    let lit: f64 = (0..n)
-                        .map(|_| self.sun_transmittance(sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET, sun.direction))
-                        .sum();
-                    channels.sun = sun.normal_irradiance() * cos * lit / n as f64;
-                }
+            if beams.iter().any(|b| normal.dot(b.to_light) > 0.0) {
+                let triangles = self.patch_triangles(side / 2);
+                let mut rng = Rng::new(3, side as u64);
+                let n = self.settings.sun_samples_per_patch;
+                let total: f64 = (0..n).map(|_| self.beams_irradiance(sample_area(&triangles, &mut rng), normal, &beams)).sum();
+                channels.sun = total / n as f64;
             }
             channels
         });
@@ -549,18 +609,15 @@ impl LightModel {
         let sensors: Vec<SensorDirect> = par_map(self.settings.threads, self.sensors.len(), |i| {
             let geometry = &self.sensors[i];
             let mut out = SensorDirect { sky: sky_irradiance(&geometry.gather), ..Default::default() };
-            let Some(sun) = sun else { return out };
-            let cos = geometry.normal.dot(sun.direction);
-            if cos > 0.0 {
-                let lit: f64 = geometry.sun_points.iter().map(|&p| self.sun_transmittance(p, sun.direction)).sum();
-                out.sun = sun.normal_irradiance() * cos * lit / geometry.sun_points.len() as f64;
+            if beams.is_empty() {
+                return out;
             }
+            let total: f64 = geometry.sun_points.iter().map(|&p| self.beams_irradiance(p, geometry.normal, &beams)).sum();
+            out.sun = total / geometry.sun_points.len() as f64;
             for &(j, w, point) in &geometry.hits {
                 let side_normal = self.patch_normal(j / 2) * if j % 2 == 1 { -1.0 } else { 1.0 };
-                let cos = side_normal.dot(sun.direction);
-                if cos > 0.0 {
-                    let origin = glam::Vec3::from_array(point).as_dvec3() + side_normal * SURFACE_OFFSET;
-                    let e = sun.normal_irradiance() * cos * self.sun_transmittance(origin, sun.direction);
+                if beams.iter().any(|b| side_normal.dot(b.to_light) > 0.0) {
+                    let e = self.beams_irradiance(glam::Vec3::from_array(point).as_dvec3(), side_normal, &beams);
                     for c in 0..3 {
                         out.sun_bounce[c] += f64::from(w) * reflectance[j as usize][c] * e;
                     }

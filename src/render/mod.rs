@@ -7,6 +7,7 @@
 
 pub mod legend;
 pub mod offscreen;
+pub mod reference;
 pub mod shadow_volume;
 pub mod sun_pass;
 pub mod surfaces;
@@ -138,7 +139,7 @@ fn update_sun_pass(
     sun_sky: Option<Res<SunSky>>,
     settings: Res<RenderSettings>,
     mut input: ResMut<SunPassInput>,
-    mut lit: Local<Option<(usize, Arc<Vec<f32>>)>>,
+    mut per_scene: Local<Option<(usize, Arc<Vec<f32>>, Arc<LightModel>)>>,
     mut generation: Local<u64>,
 ) {
     let scene_changed = active.is_changed();
@@ -154,17 +155,19 @@ fn update_sun_pass(
         input.0 = None;
         return;
     };
+    // The lit surfaces and a ray-query model (panel windows and their
+    // lobes) are made once per scene.
     let scene_id = Arc::as_ptr(scene) as usize;
-    let vertices = match &*lit {
-        Some((id, vertices)) if *id == scene_id => vertices.clone(),
+    let (vertices, model) = match &*per_scene {
+        Some((id, vertices, model)) if *id == scene_id => (vertices.clone(), model.clone()),
         _ => {
-            let vertices = Arc::new(lit_vertices(scene));
-            *lit = Some((scene_id, vertices.clone()));
-            vertices
+            let made = (Arc::new(lit_vertices(scene)), Arc::new(LightModel::unlit(scene.clone())));
+            *per_scene = Some((scene_id, made.0.clone(), made.1.clone()));
+            made
         }
     };
     *generation += 1;
-    let frame = SunPassFrame::new(scene, vertices, sun.direction.as_vec3(), sun.normal_irradiance() as f32, *generation);
+    let frame = SunPassFrame::new(scene, &model, vertices, &sun, *generation);
     input.0 = Some(Arc::new(frame));
 }
 

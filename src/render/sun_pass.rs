@@ -40,8 +40,9 @@ use bevy::render::view::{ViewDepthTexture, ViewTarget, ViewUniform, ViewUniformO
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 
 use super::shadow_volume::shadow_volume;
-use crate::light::Glass;
+use crate::light::{Glass, LightModel};
 use crate::scene::{MaterialKind, Scene};
+use crate::sky::SunSource;
 
 /// Depth bias of the opaque casters' caps, away from the camera (reverse Z:
 /// negative), so the lit face of a caster, which is its volume's near cap,
@@ -58,17 +59,28 @@ pub struct SunPassPlugin;
 #[derive(Component, Clone, Copy, Default, ExtractComponent)]
 pub struct SunPassView;
 
-/// A light direction and where it may come from.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A light along a pass's direction and the aperture it comes through.
+#[derive(Debug, Clone, PartialEq)]
 pub struct SunLight {
-    /// Unit vector toward the light.
+    /// Unit vector toward the light (the sun, or a lobe's fake sun).
     pub direction: Vec3,
     /// Irradiance normal to `direction` after the window, W/m².
     pub irradiance: f32,
-    /// The aperture it passes (index into [`SunPassFrame::windows`]);
-    /// `None`: light that meets no surface at all on its way (the outside
-    /// of the model).
-    pub window: Option<usize>,
+    /// The aperture's volume (range in [`SunPassFrame::volumes`]); `None`:
+    /// light that meets no surface at all (the outside of the model), with
+    /// every window's volume counted as blocking.
+    pub aperture: Option<Range<u32>>,
+}
+
+/// Everything drawn for one light direction: the opaque casters' volume
+/// along it, then its lights.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DirectionPass {
+    pub opaque_caps: Range<u32>,
+    pub opaque_sides: Range<u32>,
+    /// Every window's volume along this direction (for the outside light).
+    pub all_windows: Range<u32>,
+    pub lights: Vec<SunLight>,
 }
 
 /// What the sun pass draws for the current scene, sun and mode.
@@ -77,15 +89,10 @@ pub struct SunPassFrame {
     pub generation: u64,
     /// Lit surfaces as interleaved position, normal, albedo (9 floats per vertex).
     pub lit: Arc<Vec<f32>>,
-    /// All shadow volumes: the opaque casters' caps and sides, then each
-    /// window's volume.
+    /// All shadow volumes, referred to by ranges.
     pub volumes: Vec<Vec4>,
-    pub opaque_caps: Range<u32>,
-    pub opaque_sides: Range<u32>,
-    /// Volume of each aperture: the windows of one material that face one
-    /// way (their light shares a transmittance).
-    pub windows: Vec<Range<u32>>,
-    pub lights: Vec<SunLight>,
+    /// The sun's direction first, then each panel lobe's.
+    pub passes: Vec<DirectionPass>,
 }
 
 /// The main world's hand-over to the render world; `None` draws nothing.
@@ -93,9 +100,14 @@ pub struct SunPassFrame {
 pub struct SunPassInput(pub Option<Arc<SunPassFrame>>);
 
 impl SunPassFrame {
-    /// The passes for `scene` under a sun in `to_sun` with normal irradiance
-    /// `normal_irradiance` (W/m²), sharing `lit` (see [`lit_vertices`]).
-    pub fn new(scene: &Scene, lit: Arc<Vec<f32>>, to_sun: Vec3, normal_irradiance: f32, generation: u64) -> Self {
+    /// The passes for `scene` under `sun`, sharing `lit` (see
+    /// [`lit_vertices`]); `model` knows the panel windows and their lobes.
+    /// The sun's pass lights through glass (Radiance's transmittance at each
+    /// aperture's angle) and the outside; each panel lobe is a fake sun with
+    /// a pass of its own through its panel's windows (the thesis' 1 + 2·k·d
+    /// passes). The real sun's shading of a panel from outside is not drawn
+    /// for lobes yet (the engine's numbers include it).
+    pub fn new(scene: &Scene, model: &LightModel, lit: Arc<Vec<f32>>, sun: &SunSource, generation: u64) -> Self {
         let surface_triangles = |surface: u32| {
             let range = scene.surfaces[surface as usize].triangles.clone();
             scene.triangles[range.start as usize..range.end as usize].iter().map(|t| t.vertices)
@@ -106,45 +118,89 @@ impl SunPassFrame {
             .filter(|t| matches!(scene.materials[t.material as usize].kind, MaterialKind::Diffuse { .. }))
             .map(|t| t.vertices)
             .collect();
-        let opaque = shadow_volume(&opaque_casters, to_sun);
-        let opaque_caps = 0..opaque.caps.len() as u32;
-        let opaque_sides = opaque_caps.end..opaque_caps.end + opaque.sides.len() as u32;
-        let mut volumes = opaque.caps;
-        volumes.extend(opaque.sides);
-        // Windows of one material facing one way pass the sun alike: one
-        // aperture, one pass.
-        type ApertureKey = (u32, [i32; 3]);
-        let mut apertures: Vec<(ApertureKey, Vec<[Vec3; 3]>, Vec3)> = Vec::new();
-        for window in &scene.windows {
-            let key = (window.material, window.normal.to_array().map(|c| (c * 1e4).round() as i32));
-            let index = match apertures.iter().position(|a| a.0 == key) {
-                Some(index) => index,
-                None => {
-                    apertures.push((key, Vec::new(), window.normal));
-                    apertures.len() - 1
-                }
-            };
-            apertures[index].1.extend(surface_triangles(window.surface));
+        // Apertures: glass windows of one material facing one way pass the
+        // sun alike; panel windows go by the engine's panel groups.
+        #[derive(PartialEq)]
+        enum Key {
+            Glass(u32, [i32; 3]),
+            Panel(u32),
         }
-        let mut windows = Vec::with_capacity(apertures.len());
-        let mut lights = Vec::new();
-        for (index, ((material, _), panes, normal)) in apertures.into_iter().enumerate() {
-            let start = volumes.len() as u32;
-            let volume = shadow_volume(&panes, to_sun);
-            volumes.extend(volume.caps.into_iter().chain(volume.sides));
-            windows.push(start..volumes.len() as u32);
-            let cos = f64::from(normal.dot(to_sun));
-            let transmittance = match &scene.materials[material as usize].kind {
-                MaterialKind::Glass { transmittance } => Glass::from_transmittance(f64::from(*transmittance)).at(cos).0,
-                // Panels pass light straight through until panel models arrive.
-                _ => 1.0,
+        let mut apertures: Vec<(Key, Vec<[Vec3; 3]>, Vec3)> = Vec::new();
+        for window in &scene.windows {
+            let key = match model.panel_group_of_surface(window.surface) {
+                Some(group) => Key::Panel(group),
+                None => Key::Glass(window.material, window.normal.to_array().map(|c| (c * 1e4).round() as i32)),
             };
-            if cos.abs() > 1e-6 {
-                lights.push(SunLight { direction: to_sun, irradiance: normal_irradiance * transmittance as f32, window: Some(index) });
+            match apertures.iter_mut().find(|a| a.0 == key) {
+                Some(aperture) => aperture.1.extend(surface_triangles(window.surface)),
+                None => apertures.push((key, surface_triangles(window.surface).collect(), window.normal)),
             }
         }
-        lights.push(SunLight { direction: to_sun, irradiance: normal_irradiance, window: None });
-        Self { generation, lit, volumes, opaque_caps, opaque_sides, windows, lights }
+        let mut volumes: Vec<Vec4> = Vec::new();
+        let add_volume = |casters: &[[Vec3; 3]], direction: Vec3, volumes: &mut Vec<Vec4>| {
+            let volume = shadow_volume(casters, direction);
+            let start = volumes.len() as u32;
+            let caps = start..start + volume.caps.len() as u32;
+            volumes.extend(volume.caps);
+            volumes.extend(volume.sides);
+            (caps.clone(), caps.end..volumes.len() as u32)
+        };
+        let direction_pass = |direction: Vec3, volumes: &mut Vec<Vec4>| {
+            let (opaque_caps, opaque_sides) = add_volume(&opaque_casters, direction, volumes);
+            DirectionPass { opaque_caps, opaque_sides, all_windows: 0..0, lights: Vec::new() }
+        };
+        let to_sun = sun.direction.as_vec3();
+        let mut sun_pass = direction_pass(to_sun, &mut volumes);
+        let windows_start = volumes.len() as u32;
+        let mut aperture_volumes = Vec::new();
+        for (_, panes, _) in &apertures {
+            let (caps, sides) = add_volume(panes, to_sun, &mut volumes);
+            aperture_volumes.push(caps.start..sides.end);
+        }
+        sun_pass.all_windows = windows_start..volumes.len() as u32;
+        let beams = model.sun_beams(sun);
+        let mut lobe_passes = Vec::new();
+        for ((key, panes, normal), volume) in apertures.iter().zip(aperture_volumes) {
+            match key {
+                Key::Glass(material, _) => {
+                    let cos = f64::from(normal.dot(to_sun));
+                    let transmittance = match &scene.materials[*material as usize].kind {
+                        MaterialKind::Glass { transmittance } => Glass::from_transmittance(f64::from(*transmittance)).at(cos).0,
+                        _ => 1.0,
+                    };
+                    if cos.abs() > 1e-6 {
+                        let irradiance = (sun.normal_irradiance() * transmittance) as f32;
+                        sun_pass.lights.push(SunLight { direction: to_sun, irradiance, aperture: Some(volume) });
+                    }
+                }
+                Key::Panel(group) => {
+                    for beam in beams.iter().filter(|b| b.panel_group == Some(*group)) {
+                        let direction = beam.to_light.as_vec3();
+                        let mut pass = direction_pass(direction, &mut volumes);
+                        let (caps, sides) = add_volume(panes, direction, &mut volumes);
+                        pass.lights.push(SunLight { direction, irradiance: beam.normal_irradiance as f32, aperture: Some(caps.start..sides.end) });
+                        lobe_passes.push(pass);
+                    }
+                }
+            }
+        }
+        sun_pass.lights.push(SunLight { direction: to_sun, irradiance: sun.normal_irradiance() as f32, aperture: None });
+        let mut passes = vec![sun_pass];
+        passes.extend(lobe_passes);
+        Self { generation, lit, volumes, passes }
+    }
+
+    /// The lights of all passes in order (one uniform each).
+    pub fn lights(&self) -> impl Iterator<Item = &SunLight> {
+        self.passes.iter().flat_map(|p| &p.lights)
+    }
+
+    /// Draw calls per frame: per pass the opaque caps and sides, per light
+    /// through an aperture its volume twice and the lit surfaces, for the
+    /// outside light the windows' volumes and the lit surfaces; plus the
+    /// depth copy.
+    pub fn draw_count(&self) -> usize {
+        1 + self.passes.iter().map(|p| 2 + p.lights.iter().map(|l| if l.aperture.is_some() { 3 } else { 2 }).sum::<usize>()).sum::<usize>()
     }
 }
 
@@ -351,8 +407,7 @@ fn upload_frame(input: Res<SunPassInput>, mut buffers: ResMut<SunPassBuffers>, d
     buffers.volumes = vertex_buffer("heliodon_sun_volumes", &bytes(&volume_floats));
     buffers.lights.clear();
     let offsets: Vec<u32> = frame
-        .lights
-        .iter()
+        .lights()
         .map(|l| buffers.lights.push(&SunLightUniform { direction: l.direction, irradiance: l.irradiance }))
         .collect();
     buffers.light_offsets = offsets;
@@ -411,60 +466,70 @@ fn sun_pass(
     let light_group = device.create_bind_group("heliodon_sun_light", &layout(&pipelines.light_layout), &BindGroupEntries::single(light_binding));
     let depth_group = device.create_bind_group("heliodon_sun_depth", &layout(&pipelines.depth_layout), &BindGroupEntries::single(depth.view()));
 
-    let mut pass = ctx.command_encoder().begin_render_pass(&RenderPassDescriptor {
-        label: Some("heliodon_sun_pass"),
-        color_attachments: &[Some(target.get_color_attachment())],
-        depth_stencil_attachment: Some(RenderPassDepthStencilAttachment {
-            view: &stencil.0.default_view,
-            depth_ops: Some(Operations { load: LoadOp::Clear(0.0), store: StoreOp::Store }),
-            stencil_ops: Some(Operations { load: LoadOp::Clear(0), store: StoreOp::Store }),
-        }),
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
-    if let Some(viewport) = camera.viewport.as_ref() {
-        let (position, size) = (viewport.physical_position.as_vec2(), viewport.physical_size.as_vec2());
-        pass.set_viewport(position.x, position.y, size.x, size.y, viewport.depth.start, viewport.depth.end);
-    }
-    pass.set_pipeline(copy_depth);
-    pass.set_bind_group(0, &*depth_group, &[]);
-    pass.draw(0..3, 0..1);
-
     let lit_vertices = (frame.lit.len() / 9) as u32;
-    // Local macros rather than closures: wgpu's pass type is not re-exported by Bevy.
-    macro_rules! draw_volumes {
-        ($pipeline:expr, $range:expr) => {{
-            let range: Range<u32> = $range;
-            if !range.is_empty() {
-                pass.set_pipeline($pipeline);
+    let mut light_index = 0;
+    for (pass_index, direction) in frame.passes.iter().enumerate() {
+        // The first pass copies the main depth in; later ones keep that
+        // depth and start from a clear stencil.
+        let first = pass_index == 0;
+        let mut pass = ctx.command_encoder().begin_render_pass(&RenderPassDescriptor {
+            label: Some("heliodon_sun_pass"),
+            color_attachments: &[Some(target.get_color_attachment())],
+            depth_stencil_attachment: Some(RenderPassDepthStencilAttachment {
+                view: &stencil.0.default_view,
+                depth_ops: Some(Operations { load: if first { LoadOp::Clear(0.0) } else { LoadOp::Load }, store: StoreOp::Store }),
+                stencil_ops: Some(Operations { load: LoadOp::Clear(0), store: StoreOp::Store }),
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if let Some(viewport) = camera.viewport.as_ref() {
+            let (position, size) = (viewport.physical_position.as_vec2(), viewport.physical_size.as_vec2());
+            pass.set_viewport(position.x, position.y, size.x, size.y, viewport.depth.start, viewport.depth.end);
+        }
+        if first {
+            pass.set_pipeline(copy_depth);
+            pass.set_bind_group(0, &*depth_group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        // Local macros rather than closures: wgpu's pass type is not re-exported by Bevy.
+        macro_rules! draw_volumes {
+            ($pipeline:expr, $range:expr) => {{
+                let range: Range<u32> = $range;
+                if !range.is_empty() {
+                    pass.set_pipeline($pipeline);
+                    pass.set_bind_group(0, &*view_group, &[view_offset.offset]);
+                    pass.set_vertex_buffer(0, *volumes.slice(..));
+                    pass.draw(range, 0..1);
+                }
+            }};
+        }
+        macro_rules! draw_lit {
+            ($reference:expr) => {{
+                pass.set_pipeline(lit_pipeline);
                 pass.set_bind_group(0, &*view_group, &[view_offset.offset]);
-                pass.set_vertex_buffer(0, *volumes.slice(..));
-                pass.draw(range, 0..1);
+                pass.set_bind_group(1, &*light_group, &[buffers.light_offsets[light_index]]);
+                pass.set_stencil_reference($reference);
+                pass.set_vertex_buffer(0, *lit.slice(..));
+                pass.draw(0..lit_vertices, 0..1);
+            }};
+        }
+        draw_volumes!(count_caps, direction.opaque_caps.clone());
+        draw_volumes!(count_volume, direction.opaque_sides.clone());
+        for light in &direction.lights {
+            match &light.aperture {
+                Some(aperture) => {
+                    draw_volumes!(toggle_volume, aperture.clone());
+                    draw_lit!(WINDOW_BIT);
+                    draw_volumes!(toggle_volume, aperture.clone());
+                }
+                None => {
+                    draw_volumes!(count_volume, direction.all_windows.clone());
+                    draw_lit!(0);
+                }
             }
-        }};
-    }
-    macro_rules! draw_lit {
-        ($light:expr, $reference:expr) => {{
-            pass.set_pipeline(lit_pipeline);
-            pass.set_bind_group(0, &*view_group, &[view_offset.offset]);
-            pass.set_bind_group(1, &*light_group, &[buffers.light_offsets[$light]]);
-            pass.set_stencil_reference($reference);
-            pass.set_vertex_buffer(0, *lit.slice(..));
-            pass.draw(0..lit_vertices, 0..1);
-        }};
-    }
-    draw_volumes!(count_caps, frame.opaque_caps.clone());
-    draw_volumes!(count_volume, frame.opaque_sides.clone());
-    for (index, light) in frame.lights.iter().enumerate() {
-        let Some(window) = light.window else { continue };
-        let range = frame.windows[window].clone();
-        draw_volumes!(toggle_volume, range.clone());
-        draw_lit!(index, WINDOW_BIT);
-        draw_volumes!(toggle_volume, range);
-    }
-    if let Some(outside) = frame.lights.iter().position(|l| l.window.is_none()) {
-        draw_volumes!(count_volume, frame.opaque_sides.end..frame.volumes.len() as u32);
-        draw_lit!(outside, 0);
+            light_index += 1;
+        }
     }
 }

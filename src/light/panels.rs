@@ -1,0 +1,138 @@
+//! Panel windows in the light engine. Each panel window gets a frame (its
+//! normal turned into the room, its `up`); windows of one panel material
+//! facing one way form a group, whose response to the sun is computed once.
+//! Sunlight reaches the room through a panel only along its lobes: each
+//! transmitted lobe is a beam of its own, a fake sun (thesis section 3.5).
+
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use super::bvh::Tracer;
+use super::sampling::{Rng, cosine_directions};
+use crate::panel::PanelModel;
+use crate::scene::{MaterialKind, Scene, Window};
+use crate::sky::SunSource;
+
+/// A panel's frame in the model: z into the room, y its up, x = y × z.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PanelFrame {
+    pub x: DVec3,
+    pub y: DVec3,
+    pub z: DVec3,
+}
+
+impl PanelFrame {
+    /// The frame of a window whose normal into the room is `inward`, with
+    /// `up` projected onto its plane (north for a horizontal window).
+    pub fn new(inward: DVec3, up: Option<DVec3>) -> Self {
+        let z = inward.normalize();
+        let project = |v: DVec3| (v - z * v.dot(z)).try_normalize();
+        let y = up.and_then(project).or_else(|| project(DVec3::Z)).or_else(|| project(DVec3::Y)).unwrap_or(DVec3::X);
+        Self { x: y.cross(z), y, z }
+    }
+
+    pub fn to_panel(&self, d: DVec3) -> DVec3 {
+        DVec3::new(d.dot(self.x), d.dot(self.y), d.dot(self.z))
+    }
+
+    pub fn to_world(&self, d: DVec3) -> DVec3 {
+        self.x * d.x + self.y * d.y + self.z * d.z
+    }
+}
+
+/// Windows of one panel material facing one way.
+pub struct PanelGroup {
+    pub material: u32,
+    pub model: Arc<dyn PanelModel>,
+    pub frame: PanelFrame,
+}
+
+/// A beam of direct sunlight: the sun itself, or a panel lobe's fake sun.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SunBeam {
+    /// Unit vector toward the (fake) sun.
+    pub to_light: DVec3,
+    /// Irradiance normal to the beam, W/m² (for a lobe: after the panel).
+    pub normal_irradiance: f64,
+    /// The panel group the beam comes out of; `None` for the sun itself.
+    pub panel_group: Option<u32>,
+}
+
+/// Rays per hemisphere that decide which side of a window is outside.
+const SIDE_RAYS: usize = 64;
+
+/// The normal of `window` turned into the room: its outside is the side
+/// from which more of the sky is seen.
+fn inward_normal(tracer: &Tracer, window: &Window) -> DVec3 {
+    let normal = window.normal.as_dvec3();
+    let centre = window.centroid.as_dvec3();
+    let mut rng = Rng::new(5, u64::from(window.surface));
+    let open = |side: DVec3, rng: &mut Rng| {
+        cosine_directions(side, SIDE_RAYS, rng).into_iter().filter(|&d| tracer.closest(centre + side * 1e-3, d, 1e-6).is_none()).count()
+    };
+    let along = open(normal, &mut rng);
+    let against = open(-normal, &mut rng);
+    if along > against { -normal } else { normal }
+}
+
+/// The panel groups of a scene and each surface's group.
+pub fn panel_groups(scene: &Scene, tracer: &Tracer) -> (Vec<PanelGroup>, Vec<Option<u32>>) {
+    let mut groups: Vec<PanelGroup> = Vec::new();
+    let mut group_of_surface = vec![None; scene.surfaces.len()];
+    for window in &scene.windows {
+        let MaterialKind::Panel { model, up, .. } = &scene.materials[window.material as usize].kind else { continue };
+        let frame = PanelFrame::new(inward_normal(tracer, window), up.map(|u| u.as_dvec3()));
+        let same = |g: &PanelGroup| g.material == window.material && g.frame.z.dot(frame.z) > 1.0 - 1e-9 && g.frame.y.dot(frame.y) > 1.0 - 1e-9;
+        let index = match groups.iter().position(same) {
+            Some(index) => index,
+            None => {
+                groups.push(PanelGroup { material: window.material, model: model.0.clone(), frame });
+                groups.len() - 1
+            }
+        };
+        group_of_surface[window.surface as usize] = Some(index as u32);
+    }
+    (groups, group_of_surface)
+}
+
+/// The beams of direct sunlight for a sun: the sun, and for each panel
+/// group its transmitted lobes. A lobe carries the flux the panel's area
+/// receives (E · cos θin) times its share, spread over the beam's cross
+/// section (÷ cos θout).
+pub fn sun_beams(groups: &[PanelGroup], sun: &SunSource) -> Vec<SunBeam> {
+    let mut beams = vec![SunBeam { to_light: sun.direction, normal_irradiance: sun.normal_irradiance(), panel_group: None }];
+    for (index, group) in groups.iter().enumerate() {
+        let incoming = group.frame.to_panel(-sun.direction);
+        if incoming.z <= 0.0 {
+            continue;
+        }
+        for lobe in group.model.response(incoming).lobes.iter().filter(|l| l.direction.z > 1e-6 && l.share > 0.0) {
+            let out = group.frame.to_world(lobe.direction).normalize();
+            beams.push(SunBeam {
+                to_light: -out,
+                normal_irradiance: sun.normal_irradiance() * incoming.z * lobe.share / lobe.direction.z,
+                panel_group: Some(index as u32),
+            });
+        }
+    }
+    beams
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frames_are_right_handed_with_up_in_the_plane() {
+        // A south wall seen from the room: into the room is north (+y).
+        let frame = PanelFrame::new(DVec3::Y, None);
+        assert!((frame.y - DVec3::Z).length() < 1e-12);
+        assert!((frame.x.cross(frame.y) - frame.z).length() < 1e-12);
+        // A skylight: up is north.
+        let frame = PanelFrame::new(-DVec3::Z, None);
+        assert!((frame.y - DVec3::Y).length() < 1e-12);
+        let d = DVec3::new(0.3, -0.4, 0.866).normalize();
+        assert!((frame.to_world(frame.to_panel(d)) - d).length() < 1e-12);
+    }
+}
