@@ -277,7 +277,7 @@ impl LightModel {
         let done = std::sync::atomic::AtomicUsize::new(0);
         let tick = || {
             let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            if n % 64 == 0 || n == total {
+            if n.is_multiple_of(64) || n == total {
                 progress(n as f64 / total as f64);
             }
         };
@@ -618,8 +618,8 @@ impl LightModel {
                 let side_normal = self.patch_normal(j / 2) * if j % 2 == 1 { -1.0 } else { 1.0 };
                 if beams.iter().any(|b| side_normal.dot(b.to_light) > 0.0) {
                     let e = self.beams_irradiance(glam::Vec3::from_array(point).as_dvec3(), side_normal, &beams);
-                    for c in 0..3 {
-                        out.sun_bounce[c] += f64::from(w) * reflectance[j as usize][c] * e;
+                    for (bounce, rho) in out.sun_bounce.iter_mut().zip(reflectance[j as usize]) {
+                        *bounce += f64::from(w) * rho * e;
                     }
                 }
             }

@@ -133,13 +133,16 @@ pub fn false_colour(lux: f32, top: f32) -> [f32; 3] {
 #[derive(Component, Clone, Copy, Default)]
 pub struct PhysicalUnits;
 
+/// The sun pass's lit surfaces and ray-query model of a scene (by address).
+type PerScene = (usize, Arc<Vec<f32>>, Arc<LightModel>);
+
 /// Rebuilds what the sun pass draws when the scene, sun or mode change.
 fn update_sun_pass(
     active: Res<ActiveScene>,
     sun_sky: Option<Res<SunSky>>,
     settings: Res<RenderSettings>,
     mut input: ResMut<SunPassInput>,
-    mut per_scene: Local<Option<(usize, Arc<Vec<f32>>, Arc<LightModel>)>>,
+    mut per_scene: Local<Option<PerScene>>,
     mut generation: Local<u64>,
 ) {
     let scene_changed = active.is_changed();
