@@ -133,29 +133,43 @@ def write_scene(folder, comment, name, site, model, materials, sensors, grids, c
 BOSTON = {"latitude": 42.36, "longitude": -71.06, "timezone": -5.0, "ground_reflectance": 0.2}
 
 
-def test_room(prismatic=False):
+# Upper-pane panels of the test room variants (thesis fig. 1.4 and one per
+# other built-in panel): folder, title, material table.
+PANEL_ROOMS = {
+    "prismatic": ("prismatic_room", "Test room with prismatic upper panes",
+                  {"kind": "panel", "panel": "prismatic", "facet_angles": [40.0, 5.0], "refractive_index": 1.49}),
+    "laser_cut": ("laser_cut_room", "Test room with laser-cut upper panes",
+                  {"kind": "panel", "panel": "laser_cut", "cut_spacing_ratio": 0.5, "cut_angle": 0.0, "refractive_index": 1.49}),
+    "venetian": ("venetian_room", "Test room with mirrored blinds in the upper panes",
+                 {"kind": "panel", "panel": "venetian", "slat_width": 0.025, "slat_spacing": 0.0225, "tilt": -20.0,
+                  "specular": 0.9, "diffuse": 0.05}),
+}
+
+
+def test_room(panel=None):
     """Thesis figure 1.4: a 4 x 6 x 3 m room, six south windows in two rows of
-    three; with `prismatic`, the upper three panes are a prismatic panel (the
-    thesis' comparison)."""
+    three; with `panel` (a key of PANEL_ROOMS), the upper three panes are
+    that panel (the thesis' comparison)."""
+    has_panel = panel is not None
     W, D, H = 4.0, 6.0, 3.0
     obj = Obj(["Small test room: 4 x 6 x 3 m, six south windows (2 rows x 3)"
-               + (", the upper row a prismatic panel" if prismatic else ""), "z up, metres, north = +y"])
+               + (f", the upper row a {panel} panel" if has_panel else ""), "z up, metres, north = +y"])
     xs = [0.0, 0.325, 1.225, 1.55, 2.45, 2.775, 3.675, 4.0]
     zs = [0.0, 0.9, 1.9, 2.0, 2.7, 3.0]
     # South wall (y = 0): x cross z is -y, so the wall (facing the room, +y) is
     # wound the other way and the glass faces south.
     grid_wall(obj, xs, zs, lambda u, v: (u, 0.0, v), lambda i, j: i % 2 == 1 and j in (1, 3),
-              "wall", lambda i, j: "upper" if prismatic and j == 3 else "glass", wall_faces_uv=False)
+              "wall", lambda i, j: "upper" if has_panel and j == 3 else "glass", wall_faces_uv=False)
     obj.quad("floor", (0, 0, 0), (W, 0, 0), (W, D, 0), (0, D, 0))
     obj.quad("ceiling", (0, 0, H), (0, D, H), (W, D, H), (W, 0, H))
     obj.quad("wall", (0, D, 0), (W, D, 0), (W, D, H), (0, D, H))  # north wall, facing -y
     obj.quad("wall", (0, 0, 0), (0, D, 0), (0, D, H), (0, 0, H))  # west wall, facing +x
     obj.quad("wall", (W, D, 0), (W, 0, 0), (W, 0, H), (W, D, H))  # east wall, facing -x
-    folder = os.path.join(ROOT, "prismatic_room" if prismatic else "test_room")
+    folder = os.path.join(ROOT, PANEL_ROOMS[panel][0] if has_panel else "test_room")
     os.makedirs(folder, exist_ok=True)
     obj.write(os.path.join(folder, "model.obj"), "model.mtl")
     mtl = {"floor": ("diffuse", 0.2), "wall": ("diffuse", 0.5), "ceiling": ("diffuse", 0.8), "glass": ("glass", 0.88)}
-    if prismatic:
+    if has_panel:
         mtl["upper"] = ("glass", 0.88)
     write_mtl(os.path.join(folder, "model.mtl"), mtl)
     sensors = [
@@ -171,13 +185,12 @@ def test_room(prismatic=False):
         {"name": "outside", "eye": [7.0, -8.0, 5.0], "target": [2.0, 3.0, 1.5], "fov": 50.0},
     ]
     materials = {}
-    if prismatic:
-        # Redirects sunlight from a high sun up to the ceiling (thesis fig. 1.4).
-        materials["upper"] = {"kind": "panel", "panel": "prismatic", "facet_angles": [40.0, 5.0], "refractive_index": 1.49}
+    if has_panel:
+        materials["upper"] = PANEL_ROOMS[panel][2]
         sensors.append({"name": "ceiling-centre", "position": [2.0, 3.0, 3.0], "normal": [0.0, 0.0, -1.0]})
     write_scene(folder, ["Thesis figure 1.4: small test room, six south windows, Boston."
-                         + (" The upper three panes are a prismatic panel." if prismatic else "")],
-                "Test room with prismatic upper panes" if prismatic else "Small test room", BOSTON,
+                         + (f" The upper three panes are a {panel} panel." if has_panel else "")],
+                PANEL_ROOMS[panel][1] if has_panel else "Small test room", BOSTON,
                 {"obj": "model.obj", "up": "z", "north": [0.0, 1.0, 0.0], "scale": 1.0},
                 materials, sensors, grids, cameras)
     return obj.triangle_count()
@@ -367,7 +380,8 @@ def living_room():
 
 if __name__ == "__main__":
     print("test_room triangles", test_room())
-    print("prismatic_room triangles", test_room(prismatic=True))
+    for panel in PANEL_ROOMS:
+        print(PANEL_ROOMS[panel][0], "triangles", test_room(panel))
     print("office triangles", office())
     t, g = living_room()
     print("living_room triangles", t, "curved glass m2", round(g, 4))

@@ -7,7 +7,11 @@ use heliodon::bevy::prelude::App;
 
 /// The built-in panels, added the way any app adds panel plugins.
 fn add_builtin_panels(app: &mut App) {
-    app.add_plugins(heliodon_prismatic::PrismaticPlugin);
+    app.add_plugins((
+        heliodon_prismatic::PrismaticPlugin,
+        heliodon_laser_cut::LaserCutPlugin,
+        heliodon_venetian::VenetianPlugin,
+    ));
 }
 
 fn main() -> ExitCode {

@@ -27,8 +27,15 @@ fn scene(name: &str, upper: &str) -> PathBuf {
 }
 
 fn heliodon(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_heliodon")).args(args).output().expect("run heliodon");
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+    let out = Command::new(env!("CARGO_BIN_EXE_heliodon"))
+        .args(args)
+        .output()
+        .expect("run heliodon");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
 }
 
 #[test]
@@ -38,20 +45,35 @@ fn a_panel_from_a_test_only_crate_is_found_by_name() {
         app.add_plugins(GreyFilterPlugin);
     };
     let loaded = load_scene(&path, &panel_catalog(add)).expect("the fixture's panel is registered");
-    let upper = loaded.scene.materials.iter().find(|m| m.name == "upper").unwrap();
-    let MaterialKind::Panel { panel, model, .. } = &upper.kind else { panic!("{upper:?}") };
+    let upper = loaded
+        .scene
+        .materials
+        .iter()
+        .find(|m| m.name == "upper")
+        .unwrap();
+    let MaterialKind::Panel { panel, model, .. } = &upper.kind else {
+        panic!("{upper:?}")
+    };
     assert_eq!(panel, "grey_filter");
     let response = model.0.response(heliodon::glam::DVec3::new(0.0, -0.6, 0.8));
     assert!((response.transmitted() - 0.4).abs() < 1e-12);
     assert_eq!(loaded.scene.windows.len(), 1);
     // Without the plugin the same file names the panels that are known.
-    let error = load_scene(&path, &panel_catalog(|_| {})).unwrap_err().to_string();
-    assert!(error.contains("no panel named 'grey_filter' is registered (registered: none)"), "{error}");
+    let error = load_scene(&path, &panel_catalog(|_| {}))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("no panel named 'grey_filter' is registered (registered: none)"),
+        "{error}"
+    );
 }
 
 #[test]
 fn the_executable_knows_the_built_in_panels() {
-    let path = scene("prismatic", "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n");
+    let path = scene(
+        "prismatic",
+        "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n",
+    );
     let (code, out, err) = heliodon(&["info", path.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("panel    1"), "{out}");
@@ -66,10 +88,26 @@ fn the_executable_knows_the_built_in_panels() {
 #[test]
 fn bad_panel_keys_give_one_line_naming_the_key() {
     let cases = [
-        ("range", "panel = \"prismatic\"\nfacet_angles = [40.0, 95.0]\n", "scene.toml:12: materials.upper.facet_angles: 95 is outside 0..89"),
-        ("missing", "panel = \"prismatic\"\n", "scene.toml:9: materials.upper.facet_angles: is required"),
-        ("unknown", "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\nfacet_count = 3\n", "materials.upper.facet_count: is not a key of panel 'prismatic'"),
-        ("type", "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\nrefractive_index = \"acrylic\"\n", "materials.upper.refractive_index: must be a number"),
+        (
+            "range",
+            "panel = \"prismatic\"\nfacet_angles = [40.0, 95.0]\n",
+            "scene.toml:12: materials.upper.facet_angles: 95 is outside 0..89",
+        ),
+        (
+            "missing",
+            "panel = \"prismatic\"\n",
+            "scene.toml:9: materials.upper.facet_angles: is required",
+        ),
+        (
+            "unknown",
+            "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\nfacet_count = 3\n",
+            "materials.upper.facet_count: is not a key of panel 'prismatic'",
+        ),
+        (
+            "type",
+            "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\nrefractive_index = \"acrylic\"\n",
+            "materials.upper.refractive_index: must be a number",
+        ),
     ];
     for (name, body, expected) in cases {
         let path = scene(name, body);
@@ -96,22 +134,88 @@ fn room(name: &str, window: Option<&str>) -> PathBuf {
         n += 4;
     };
     let (w, d, h) = (4.0, 6.0, 3.0);
-    quad(&mut obj, "floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
-    quad(&mut obj, "wall", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
-    quad(&mut obj, "wall", [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]]);
-    quad(&mut obj, "wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
-    quad(&mut obj, "wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
+    quad(
+        &mut obj,
+        "floor",
+        [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]],
+    );
+    quad(
+        &mut obj,
+        "wall",
+        [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]],
+    );
+    quad(
+        &mut obj,
+        "wall",
+        [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]],
+    );
+    quad(
+        &mut obj,
+        "wall",
+        [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]],
+    );
+    quad(
+        &mut obj,
+        "wall",
+        [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]],
+    );
     // South wall around the opening x 1-3, z 1-2.
-    quad(&mut obj, "wall", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, 0.0, 1.0], [0.0, 0.0, 1.0]]);
-    quad(&mut obj, "wall", [[0.0, 0.0, 2.0], [w, 0.0, 2.0], [w, 0.0, h], [0.0, 0.0, h]]);
-    quad(&mut obj, "wall", [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 0.0, 2.0], [0.0, 0.0, 2.0]]);
-    quad(&mut obj, "wall", [[3.0, 0.0, 1.0], [w, 0.0, 1.0], [w, 0.0, 2.0], [3.0, 0.0, 2.0]]);
+    quad(
+        &mut obj,
+        "wall",
+        [
+            [0.0, 0.0, 0.0],
+            [w, 0.0, 0.0],
+            [w, 0.0, 1.0],
+            [0.0, 0.0, 1.0],
+        ],
+    );
+    quad(
+        &mut obj,
+        "wall",
+        [[0.0, 0.0, 2.0], [w, 0.0, 2.0], [w, 0.0, h], [0.0, 0.0, h]],
+    );
+    quad(
+        &mut obj,
+        "wall",
+        [
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 1.0],
+            [1.0, 0.0, 2.0],
+            [0.0, 0.0, 2.0],
+        ],
+    );
+    quad(
+        &mut obj,
+        "wall",
+        [
+            [3.0, 0.0, 1.0],
+            [w, 0.0, 1.0],
+            [w, 0.0, 2.0],
+            [3.0, 0.0, 2.0],
+        ],
+    );
     if window.is_some() {
-        quad(&mut obj, "window", [[1.0, 0.0, 1.0], [3.0, 0.0, 1.0], [3.0, 0.0, 2.0], [1.0, 0.0, 2.0]]);
+        quad(
+            &mut obj,
+            "window",
+            [
+                [1.0, 0.0, 1.0],
+                [3.0, 0.0, 1.0],
+                [3.0, 0.0, 2.0],
+                [1.0, 0.0, 2.0],
+            ],
+        );
     }
     std::fs::write(dir.join("room.obj"), obj).unwrap();
-    std::fs::write(dir.join("room.mtl"), "newmtl floor\nKd 0.2 0.2 0.2\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl window\nd 0.1\n").unwrap();
-    let mut text = String::from("name = \"Panel room\"\n[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n[model]\nobj = \"room.obj\"\n");
+    std::fs::write(
+        dir.join("room.mtl"),
+        "newmtl floor\nKd 0.2 0.2 0.2\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl window\nd 0.1\n",
+    )
+    .unwrap();
+    let mut text = String::from(
+        "name = \"Panel room\"\n[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n[model]\nobj = \"room.obj\"\n",
+    );
     if let Some(window) = window {
         text.push_str(&format!("\n[materials.window]\nkind = \"panel\"\n{window}"));
     }
@@ -123,18 +227,38 @@ fn room(name: &str, window: Option<&str>) -> PathBuf {
 }
 
 fn all_panels(app: &mut App) {
-    app.add_plugins((GreyFilterPlugin, heliodon_prismatic::PrismaticPlugin));
+    app.add_plugins((
+        GreyFilterPlugin,
+        heliodon_prismatic::PrismaticPlugin,
+        heliodon_laser_cut::LaserCutPlugin,
+        heliodon_venetian::VenetianPlugin,
+    ));
 }
 
 fn winter_noon(scene: &heliodon::scene::Scene) -> heliodon::sky::Sky {
     use heliodon::time::{Date, LocalDateTime, TimeOfDay};
-    let when = LocalDateTime { date: Date::new(2026, 12, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() };
+    let when = LocalDateTime {
+        date: Date::new(2026, 12, 21).unwrap(),
+        time: TimeOfDay::from_hours(12.0).unwrap(),
+    };
     let sun = heliodon::sun::solar_position(&scene.site, &when);
-    heliodon::sky::Sky::new(&heliodon::sky::SkySpec::Clear { turbidity: 2.45 }, sun.altitude, sun.azimuth, 0.2, 355).unwrap()
+    heliodon::sky::Sky::new(
+        &heliodon::sky::SkySpec::Clear { turbidity: 2.45 },
+        sun.altitude,
+        sun.azimuth,
+        0.2,
+        355,
+    )
+    .unwrap()
 }
 
 fn quick() -> heliodon::light::LightSettings {
-    heliodon::light::LightSettings { rays_per_patch: 16, rays_per_sensor: 64, sun_samples_per_patch: 64, ..Default::default() }
+    heliodon::light::LightSettings {
+        rays_per_patch: 16,
+        rays_per_sensor: 64,
+        sun_samples_per_patch: 64,
+        ..Default::default()
+    }
 }
 
 /// A panel whose one lobe goes straight on with its whole share passes the
@@ -147,15 +271,35 @@ fn a_straight_lobe_passes_the_sun_as_an_opening_does() {
     let direct_sun = |path: PathBuf| -> Vec<f64> {
         let scene = Arc::new(load_scene(&path, &catalog).unwrap().scene);
         let model = heliodon::light::LightModel::precompute(scene.clone(), quick()).unwrap();
-        model.solve(&winter_noon(&scene), None).sensors.iter().map(|s| s.direct_sun).collect()
+        model
+            .solve(&winter_noon(&scene), None)
+            .sensors
+            .iter()
+            .map(|s| s.direct_sun)
+            .collect()
     };
     let open = direct_sun(room("open", None));
-    let clear = direct_sun(room("clear", Some("panel = \"grey_filter\"\ntransmittance = 1.0\n")));
-    let grey = direct_sun(room("grey", Some("panel = \"grey_filter\"\ntransmittance = 0.4\n")));
-    assert!(open.iter().filter(|&&e| e > 1000.0).count() >= 2, "the beam reaches the floor sensors: {open:?}");
+    let clear = direct_sun(room(
+        "clear",
+        Some("panel = \"grey_filter\"\ntransmittance = 1.0\n"),
+    ));
+    let grey = direct_sun(room(
+        "grey",
+        Some("panel = \"grey_filter\"\ntransmittance = 0.4\n"),
+    ));
+    assert!(
+        open.iter().filter(|&&e| e > 1000.0).count() >= 2,
+        "the beam reaches the floor sensors: {open:?}"
+    );
     for ((o, c), g) in open.iter().zip(&clear).zip(&grey) {
-        assert!((c - o).abs() <= 1e-6 * o.max(1.0), "open {o} vs clear panel {c}");
-        assert!((g - 0.4 * o).abs() <= 1e-6 * o.max(1.0), "open {o} vs grey panel {g}");
+        assert!(
+            (c - o).abs() <= 1e-6 * o.max(1.0),
+            "open {o} vs clear panel {c}"
+        );
+        assert!(
+            (g - 0.4 * o).abs() <= 1e-6 * o.max(1.0),
+            "open {o} vs grey panel {g}"
+        );
     }
 }
 
@@ -165,7 +309,10 @@ fn a_straight_lobe_passes_the_sun_as_an_opening_does() {
 #[test]
 fn sunlight_through_a_prismatic_window_is_conserved() {
     use std::sync::Arc;
-    let path = room("prismatic", Some("panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n"));
+    let path = room(
+        "prismatic",
+        Some("panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n"),
+    );
     let scene = Arc::new(load_scene(&path, &panel_catalog(all_panels)).unwrap().scene);
     let model = heliodon::light::LightModel::precompute(scene.clone(), quick()).unwrap();
     let sky = winter_noon(&scene);
@@ -177,50 +324,81 @@ fn sunlight_through_a_prismatic_window_is_conserved() {
         .patches
         .iter()
         .enumerate()
-        .filter(|(_, p)| matches!(scene.materials[p.material as usize].kind, MaterialKind::Diffuse { .. }))
+        .filter(|(_, p)| {
+            matches!(
+                scene.materials[p.material as usize].kind,
+                MaterialKind::Diffuse { .. }
+            )
+        })
         .map(|(i, p)| {
-            let inward = if p.normal.as_dvec3().dot(centre - p.centroid.as_dvec3()) > 0.0 { 2 * i } else { 2 * i + 1 };
+            let inward = if p.normal.as_dvec3().dot(centre - p.centroid.as_dvec3()) > 0.0 {
+                2 * i
+            } else {
+                2 * i + 1
+            };
             f64::from(p.area) * lighting.sides[inward].sun
         })
         .sum();
     let sun = sky.sun.unwrap();
     let window = &scene.windows[0];
-    let MaterialKind::Panel { model: panel, .. } = &scene.materials[window.material as usize].kind else { panic!() };
+    let MaterialKind::Panel { model: panel, .. } = &scene.materials[window.material as usize].kind
+    else {
+        panic!()
+    };
     let frame = heliodon::light::PanelFrame::new(heliodon::glam::DVec3::Y, None);
     let incoming = frame.to_panel(-sun.direction);
     let transmitted = panel.0.response(incoming).transmitted();
     let expected = sun.normal_irradiance() * incoming.z * f64::from(window.area) * transmitted;
     println!("landed {landed:.1} W, expected {expected:.1} W (transmitted share {transmitted:.3})");
     assert!(transmitted > 0.5);
-    assert!((landed / expected - 1.0).abs() < 0.03, "landed {landed} vs {expected}");
+    assert!(
+        (landed / expected - 1.0).abs() < 0.03,
+        "landed {landed} vs {expected}"
+    );
 }
 
-/// The renderer draws each prismatic lobe as a fake sun: the direct-sun
-/// image of the prismatic room agrees with the CPU reference (shadow rays
-/// along the lobes through the panel), pixel by pixel.
+/// The renderer draws each panel lobe as a fake sun: the direct-sun image
+/// of each panel room agrees with the CPU reference (shadow rays along the
+/// lobes through the panel), pixel by pixel.
 #[test]
-fn prismatic_lobes_are_drawn_where_the_engine_puts_them() {
+fn panel_lobes_are_drawn_where_the_engine_puts_them() {
     use heliodon::render::offscreen::OffscreenRequest;
     use heliodon::render::reference::compare_direct_sun;
     use heliodon::render::{RenderMode, RenderSettings};
     use heliodon::time::{Date, LocalDateTime, TimeOfDay};
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes/prismatic_room/scene.toml");
-    let scene = load_scene(&path, &panel_catalog(all_panels)).unwrap().scene;
-    for (date, hours) in [((2026, 12, 21), 12.0), ((2026, 3, 21), 10.0)] {
+    for (room, date, hours) in [
+        ("prismatic_room", (2026, 12, 21), 12.0),
+        ("prismatic_room", (2026, 3, 21), 10.0),
+        ("laser_cut_room", (2026, 3, 21), 12.0),
+        ("venetian_room", (2026, 3, 21), 12.0),
+    ] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("../assets/scenes/{room}/scene.toml"));
+        let scene = load_scene(&path, &panel_catalog(all_panels)).unwrap().scene;
         let request = OffscreenRequest {
             scene: path.clone(),
             view: Some(scene.viewpoints[0].clone()),
             width: 320,
             height: 200,
-            when: Some(LocalDateTime { date: Date::new(date.0, date.1, date.2).unwrap(), time: TimeOfDay::from_hours(hours).unwrap() }),
+            when: Some(LocalDateTime {
+                date: Date::new(date.0, date.1, date.2).unwrap(),
+                time: TimeOfDay::from_hours(hours).unwrap(),
+            }),
             sky: Some(heliodon::sky::SkySpec::Clear { turbidity: 2.45 }),
-            settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
+            settings: RenderSettings {
+                mode: RenderMode::Sun,
+                ..Default::default()
+            },
             add_panels: all_panels,
         };
-        let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("sun_prismatic_room_{}_{hours}.png", date.1));
+        let file = Path::new(env!("CARGO_TARGET_TMPDIR"))
+            .join(format!("sun_{room}_{}_{hours}.png", date.1));
         let result = compare_direct_sun(&request, &file).unwrap();
-        println!("prismatic room {date:?} {hours}: {result} -> {}", file.display());
+        println!("{room} {date:?} {hours}: {result} -> {}", file.display());
         assert!(result.lit > 500, "{result}");
-        assert!(result.agreement >= 0.99 && result.within >= 0.99, "{result}");
+        assert!(
+            result.agreement >= 0.99 && result.within >= 0.99,
+            "{result}"
+        );
     }
 }

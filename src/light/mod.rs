@@ -309,7 +309,8 @@ impl LightModel {
 
     /// Direct sun irradiance (W/m²) at `point` on a surface side with
     /// `normal`: shadow rays through glass toward the sun, and through panel
-    /// windows along their lobes.
+    /// windows along their lobes. For many points, get the beams once
+    /// ([`Self::sun_beams`]) and use [`Self::beams_irradiance`].
     pub fn sun_irradiance(&self, point: DVec3, normal: DVec3, sun: &crate::sky::SunSource) -> f64 {
         self.beams_irradiance(point, normal, &self.sun_beams(sun))
     }
@@ -492,7 +493,7 @@ impl LightModel {
 
     /// Direct sun irradiance (W/m²) from all `beams` at `point` on a surface
     /// side with `normal`.
-    fn beams_irradiance(&self, point: DVec3, normal: DVec3, beams: &[SunBeam]) -> f64 {
+    pub fn beams_irradiance(&self, point: DVec3, normal: DVec3, beams: &[SunBeam]) -> f64 {
         let sun = beams.first().map_or(DVec3::Z, |b| b.to_light);
         let origin = point + normal * SURFACE_OFFSET;
         beams

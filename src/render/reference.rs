@@ -85,12 +85,13 @@ pub fn compare_direct_sun(request: &OffscreenRequest, picture: &Path) -> Result<
     let mut worst: f64 = 0.0;
     let mut disagreement = image::RgbImage::new(width, height);
     let eye = view.eye.as_dvec3();
+    let beams = model.sun_beams(&sun);
     for (k, (ray, pixel)) in camera_rays(&view, width, height).into_iter().zip(&image.physical).enumerate() {
         let Some((patch, distance)) = model.trace(eye, ray) else { continue };
         let patch = &scene.patches.patches[patch as usize];
         let MaterialKind::Diffuse { reflectance } = &scene.materials[patch.material as usize].kind else { continue };
         let normal = patch.normal.as_dvec3() * if patch.normal.as_dvec3().dot(ray) > 0.0 { -1.0 } else { 1.0 };
-        let irradiance = model.sun_irradiance(eye + ray * distance, normal, &sun);
+        let irradiance = model.beams_irradiance(eye + ray * distance, normal, &beams);
         let expected = f64::from(reflectance.0[1]) / std::f64::consts::PI * irradiance * LUMINOUS_EFFICACY;
         let got = f64::from(pixel[1]);
         compared += 1;
