@@ -143,6 +143,8 @@ PANEL_ROOMS = {
     "venetian": ("venetian_room", "Test room with mirrored blinds in the upper panes",
                  {"kind": "panel", "panel": "venetian", "slat_width": 0.025, "slat_spacing": 0.0225, "tilt": -20.0,
                   "specular": 0.9, "diffuse": 0.05}),
+    "bsdf": ("bsdf_room", "Test room with measured blinds (BSDF) in the upper panes",
+             {"kind": "panel", "panel": "bsdf", "file": "../../bsdf/blinds.xml", "lobes": 3, "lobe_width": 23.0}),
 }
 
 

@@ -11,6 +11,7 @@ fn add_builtin_panels(app: &mut App) {
         heliodon_prismatic::PrismaticPlugin,
         heliodon_laser_cut::LaserCutPlugin,
         heliodon_venetian::VenetianPlugin,
+        heliodon_bsdf::BsdfPlugin,
     ));
 }
 

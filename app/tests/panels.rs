@@ -82,7 +82,7 @@ fn the_executable_knows_the_built_in_panels() {
     let (code, _, err) = heliodon(&["info", path.to_str().unwrap()]);
     assert_ne!(code, 0);
     assert_eq!(err.trim().lines().count(), 1, "{err}");
-    assert!(err.contains("scene.toml:11: materials.upper.panel: no panel named 'lenticular' is registered (registered: prismatic"), "{err}");
+    assert!(err.contains("scene.toml:11: materials.upper.panel: no panel named 'lenticular' is registered (registered: bsdf, laser_cut, prismatic, venetian)"), "{err}");
 }
 
 #[test]
@@ -232,6 +232,7 @@ fn all_panels(app: &mut App) {
         heliodon_prismatic::PrismaticPlugin,
         heliodon_laser_cut::LaserCutPlugin,
         heliodon_venetian::VenetianPlugin,
+        heliodon_bsdf::BsdfPlugin,
     ));
 }
 
@@ -371,6 +372,7 @@ fn panel_lobes_are_drawn_where_the_engine_puts_them() {
         ("prismatic_room", (2026, 3, 21), 10.0),
         ("laser_cut_room", (2026, 3, 21), 12.0),
         ("venetian_room", (2026, 3, 21), 12.0),
+        ("bsdf_room", (2026, 3, 21), 10.0),
     ] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join(format!("../assets/scenes/{room}/scene.toml"));

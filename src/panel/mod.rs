@@ -27,7 +27,7 @@ pub struct Lobe {
     pub direction: DVec3,
     /// Share of the incoming flux (0-1).
     pub share: f64,
-    /// Angular width (half-angle of the cone), degrees.
+    /// Angular width: the full angle of the cone it spreads over, degrees.
     pub width: f64,
 }
 
