@@ -269,38 +269,23 @@ fn quick() -> heliodon::light::LightSettings {
 fn a_straight_lobe_passes_the_sun_as_an_opening_does() {
     use std::sync::Arc;
     let catalog = panel_catalog(all_panels);
-    let direct_sun = |path: PathBuf| -> Vec<f64> {
+    // Direct sun and direct sky at each floor sensor.
+    let direct = |path: PathBuf| -> Vec<(f64, f64)> {
         let scene = Arc::new(load_scene(&path, &catalog).unwrap().scene);
         let model = heliodon::light::LightModel::precompute(scene.clone(), quick()).unwrap();
-        model
-            .solve(&winter_noon(&scene), None)
-            .sensors
-            .iter()
-            .map(|s| s.direct_sun)
-            .collect()
+        let lighting = model.solve(&winter_noon(&scene), None);
+        lighting.sensors.iter().map(|s| (s.direct_sun, s.direct_sky)).collect()
     };
-    let open = direct_sun(room("open", None));
-    let clear = direct_sun(room(
-        "clear",
-        Some("panel = \"grey_filter\"\ntransmittance = 1.0\n"),
-    ));
-    let grey = direct_sun(room(
-        "grey",
-        Some("panel = \"grey_filter\"\ntransmittance = 0.4\n"),
-    ));
-    assert!(
-        open.iter().filter(|&&e| e > 1000.0).count() >= 2,
-        "the beam reaches the floor sensors: {open:?}"
-    );
+    let open = direct(room("open", None));
+    let clear = direct(room("clear", Some("panel = \"grey_filter\"\ntransmittance = 1.0\n")));
+    let grey = direct(room("grey", Some("panel = \"grey_filter\"\ntransmittance = 0.4\n")));
+    assert!(open.iter().filter(|e| e.0 > 1000.0).count() >= 2, "the beam reaches the floor sensors: {open:?}");
+    assert!(open.iter().all(|e| e.1 > 10.0), "the sky is seen: {open:?}");
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * a.max(1.0);
     for ((o, c), g) in open.iter().zip(&clear).zip(&grey) {
-        assert!(
-            (c - o).abs() <= 1e-6 * o.max(1.0),
-            "open {o} vs clear panel {c}"
-        );
-        assert!(
-            (g - 0.4 * o).abs() <= 1e-6 * o.max(1.0),
-            "open {o} vs grey panel {g}"
-        );
+        // The sun along the lobe's beam, the sky through the panel's transfer.
+        assert!(close(o.0, c.0) && close(o.1, c.1), "open {o:?} vs clear panel {c:?}");
+        assert!(close(0.4 * o.0, g.0) && close(0.4 * o.1, g.1), "open {o:?} vs grey panel {g:?}");
     }
 }
 

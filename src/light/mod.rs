@@ -174,9 +174,9 @@ pub fn side_of(patch: u32, back: bool) -> u32 {
 enum Surface {
     Diffuse([f64; 3]),
     Glass(Glass),
-    /// A panel window of this group: the sun passes only along its lobes;
-    /// sky light still passes straight through (the sky transfer of panels
-    /// is not modelled yet).
+    /// A panel window of this group: rays pass on (what they see beyond is
+    /// turned into the panel's light at relight time, see
+    /// `PanelGroup::radiance_through`); the sun passes only along its lobes.
     Panel(u32),
 }
 
@@ -576,12 +576,10 @@ impl LightModel {
     /// patch side and sensor) is computed now; [`Relight::step`] then iterates
     /// the interreflection, and [`Relight::lighting`] reads the state at any time.
     pub fn relight(&self, sky: &Sky, warm: Option<&Lighting>) -> Relight<'_> {
-        let mut bin_radiance = Vec::with_capacity(2 * self.bins.len());
-        self.bins.integrate_sphere_into(sky, &mut bin_radiance);
         let patches = &self.scene.patches.patches;
-        let bin_count = self.bin_count();
-        let sky_irradiance = |g: &Gather| PI * g.bins.iter().map(|&(k, w)| f64::from(w) * bin_radiance[(k % bin_count) as usize]).sum::<f64>();
         let sun = sky.sun.filter(|s| s.direction.z > 0.0);
+        let seen = self.key_radiance(sky);
+        let sky_irradiance = |g: &Gather| PI * g.bins.iter().map(|&(k, w)| f64::from(w) * seen.of(k)).sum::<f64>();
         let beams = sun.map(|s| self.sun_beams(&s)).unwrap_or_default();
         let direct: Vec<Channels> = par_map(self.settings.threads, patches.len() * 2, |side| {
             let gather = &self.side_gathers[side];
@@ -643,6 +641,27 @@ impl LightModel {
         }
     }
 
+}
+
+/// Radiance behind gather keys ([`SkyKey`]) for one sky.
+struct KeyRadiance {
+    bin_count: u32,
+    /// Per sphere bin.
+    bins: Vec<f64>,
+    /// Per panel group, per sphere bin: seen through its windows.
+    panels: Vec<Vec<f64>>,
+    /// Per scene window: its panel group.
+    window_panel: Vec<Option<u32>>,
+}
+
+impl KeyRadiance {
+    fn of(&self, key: u32) -> f64 {
+        let key = SkyKey::unpack(key, self.bin_count);
+        match key.window.and_then(|w| self.window_panel[w as usize]) {
+            Some(group) => self.panels[group as usize][key.bin as usize],
+            None => self.bins[key.bin as usize],
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -781,15 +800,14 @@ impl LightModel {
     /// comes from: `(None, lux)` straight from outside, `(Some(k), lux)`
     /// through window `k` of [`Scene::windows`]. Sums to `direct_sky`.
     pub fn sky_through_windows(&self, sky: &Sky) -> Vec<Vec<(Option<u32>, f64)>> {
-        let mut bin_radiance = Vec::with_capacity(self.bin_count() as usize);
-        self.bins.integrate_sphere_into(sky, &mut bin_radiance);
+        let seen = self.key_radiance(sky);
         self.sensors
             .iter()
             .map(|geometry| {
                 let mut by_window: Vec<(Option<u32>, f64)> = Vec::new();
                 for &(k, w) in &geometry.gather.bins {
                     let key = SkyKey::unpack(k, self.bin_count());
-                    let lux = PI * f64::from(w) * bin_radiance[key.bin as usize] * LUMINOUS_EFFICACY;
+                    let lux = PI * f64::from(w) * seen.of(k) * LUMINOUS_EFFICACY;
                     match by_window.last_mut() {
                         Some(last) if last.0 == key.window => last.1 += lux,
                         _ => by_window.push((key.window, lux)),
@@ -798,6 +816,17 @@ impl LightModel {
                 by_window
             })
             .collect()
+    }
+
+    /// The radiance behind each gather key under `sky`: a bin's own, or
+    /// through a panel window what the panel makes of the sky and sun.
+    fn key_radiance(&self, sky: &Sky) -> KeyRadiance {
+        let mut bins = Vec::with_capacity(self.bin_count() as usize);
+        self.bins.integrate_sphere_into(sky, &mut bins);
+        let sun = sky.sun.filter(|s| s.direction.z > 0.0);
+        let panels = self.panel_groups.iter().map(|g| g.radiance_through(&self.bins, &bins, sun.as_ref())).collect();
+        let window_panel = self.scene.windows.iter().map(|w| self.group_of_surface[w.surface as usize]).collect();
+        KeyRadiance { bin_count: self.bin_count(), bins, panels, window_panel }
     }
 
     /// Sensors that seem to sit inside a solid: every ray from them meets a

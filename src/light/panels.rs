@@ -4,7 +4,7 @@
 //! Sunlight reaches the room through a panel only along its lobes: each
 //! transmitted lobe is a beam of its own, a fake sun (thesis section 3.5).
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use glam::DVec3;
 
@@ -12,7 +12,7 @@ use super::bvh::Tracer;
 use super::sampling::{Rng, cosine_directions};
 use crate::panel::PanelModel;
 use crate::scene::{MaterialKind, Scene, Window};
-use crate::sky::SunSource;
+use crate::sky::{SkyPatches, SunSource};
 
 /// A panel's frame in the model: z into the room, y its up, x = y × z.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,6 +46,77 @@ pub struct PanelGroup {
     pub material: u32,
     pub model: Arc<dyn PanelModel>,
     pub frame: PanelFrame,
+    /// How sky and ground light pass it, made on first use.
+    transfer: OnceLock<SkyTransfer>,
+}
+
+/// How a panel group passes sky and ground light, per sphere bin the light
+/// comes from: the bins its lobes leave along, as factors from the
+/// incoming bin's radiance to the radiance seen through the panel in the
+/// outgoing bin (share · cos θin · ωin / (cos θout · ωout)), and the factor
+/// to the radiance of its diffuse transmission (τd · cos θin · ωin / π).
+/// The panel is taken to see the sky and ground unobstructed.
+pub struct SkyTransfer {
+    pub lobes: Vec<Vec<(u32, f64)>>,
+    pub diffuse: Vec<f64>,
+}
+
+impl PanelGroup {
+    /// The group's sky transfer over `bins`' sphere bins.
+    pub fn sky_transfer(&self, bins: &SkyPatches) -> &SkyTransfer {
+        self.transfer.get_or_init(|| {
+            let count = 2 * bins.len();
+            let direction = |b: usize| {
+                let d = bins.patches[b % bins.len()].direction;
+                if b < bins.len() { d } else { DVec3::new(d.x, d.y, -d.z) }
+            };
+            let solid_angle = |b: usize| bins.patches[b % bins.len()].solid_angle;
+            let mut transfer = SkyTransfer { lobes: vec![Vec::new(); count], diffuse: vec![0.0; count] };
+            for b in 0..count {
+                // Light from bin b travels away from it.
+                let incoming = self.frame.to_panel(-direction(b));
+                if incoming.z <= 0.0 {
+                    continue;
+                }
+                let flux = incoming.z * solid_angle(b);
+                let response = self.model.response(incoming);
+                for lobe in response.lobes.iter().filter(|l| l.direction.z > 1e-6 && l.share > 0.0) {
+                    // Seen from the room, looking back against the lobe.
+                    let out = bins.sphere_bin(-self.frame.to_world(lobe.direction));
+                    let factor = lobe.share * flux / (lobe.direction.z * solid_angle(out));
+                    transfer.lobes[b].push((out as u32, factor));
+                }
+                transfer.diffuse[b] = response.diffuse_transmittance * flux / std::f64::consts::PI;
+            }
+            transfer
+        })
+    }
+
+    /// Radiance (W/sr/m²) seen through the group's windows in every sphere
+    /// bin, for bin radiances `sky` and the sun (whose lobes are beams of
+    /// their own; its diffuse transmission is added here).
+    pub fn radiance_through(&self, bins: &SkyPatches, sky: &[f64], sun: Option<&SunSource>) -> Vec<f64> {
+        let transfer = self.sky_transfer(bins);
+        let mut out = vec![0.0; sky.len()];
+        let mut diffuse = 0.0;
+        for (b, &radiance) in sky.iter().enumerate() {
+            if radiance <= 0.0 {
+                continue;
+            }
+            for &(o, factor) in &transfer.lobes[b] {
+                out[o as usize] += factor * radiance;
+            }
+            diffuse += transfer.diffuse[b] * radiance;
+        }
+        if let Some(sun) = sun.filter(|s| s.direction.z > 0.0) {
+            let incoming = self.frame.to_panel(-sun.direction);
+            if incoming.z > 0.0 {
+                diffuse += sun.normal_irradiance() * incoming.z * self.model.response(incoming).diffuse_transmittance / std::f64::consts::PI;
+            }
+        }
+        out.iter_mut().for_each(|r| *r += diffuse);
+        out
+    }
 }
 
 /// A beam of direct sunlight: the sun itself, or a panel lobe's fake sun.
@@ -87,7 +158,7 @@ pub fn panel_groups(scene: &Scene, tracer: &Tracer) -> (Vec<PanelGroup>, Vec<Opt
         let index = match groups.iter().position(same) {
             Some(index) => index,
             None => {
-                groups.push(PanelGroup { material: window.material, model: model.0.clone(), frame });
+                groups.push(PanelGroup { material: window.material, model: model.0.clone(), frame, transfer: OnceLock::new() });
                 groups.len() - 1
             }
         };
