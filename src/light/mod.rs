@@ -248,7 +248,7 @@ pub struct Lighting {
 
 /// Maps `f` over `0..count` on `threads` threads (all cores when `None`);
 /// the result does not depend on how the work is split.
-fn par_map<T: Send>(threads: Option<usize>, count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+pub(crate) fn par_map<T: Send>(threads: Option<usize>, count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
     let available = std::thread::available_parallelism().map_or(1, |n| n.get());
     let threads = threads.unwrap_or(available).max(1).min(count.max(1));
     let chunk = count.div_ceil(threads).max(1);

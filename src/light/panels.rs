@@ -71,23 +71,29 @@ impl PanelGroup {
                 if b < bins.len() { d } else { DVec3::new(d.x, d.y, -d.z) }
             };
             let solid_angle = |b: usize| bins.patches[b % bins.len()].solid_angle;
-            let mut transfer = SkyTransfer { lobes: vec![Vec::new(); count], diffuse: vec![0.0; count] };
-            for b in 0..count {
+            // Each bin on its own (panel responses can be costly): in parallel.
+            let per_bin = super::par_map(None, count, |b| {
                 // Light from bin b travels away from it.
                 let incoming = self.frame.to_panel(-direction(b));
                 if incoming.z <= 0.0 {
-                    continue;
+                    return (Vec::new(), 0.0);
                 }
                 let flux = incoming.z * solid_angle(b);
                 let response = self.model.response(incoming);
-                for lobe in response.lobes.iter().filter(|l| l.direction.z > 1e-6 && l.share > 0.0) {
-                    // Seen from the room, looking back against the lobe.
-                    let out = bins.sphere_bin(-self.frame.to_world(lobe.direction));
-                    let factor = lobe.share * flux / (lobe.direction.z * solid_angle(out));
-                    transfer.lobes[b].push((out as u32, factor));
-                }
-                transfer.diffuse[b] = response.diffuse_transmittance * flux / std::f64::consts::PI;
-            }
+                let lobes = response
+                    .lobes
+                    .iter()
+                    .filter(|l| l.direction.z > 1e-6 && l.share > 0.0)
+                    .map(|lobe| {
+                        // Seen from the room, looking back against the lobe.
+                        let out = bins.sphere_bin(-self.frame.to_world(lobe.direction));
+                        (out as u32, lobe.share * flux / (lobe.direction.z * solid_angle(out)))
+                    })
+                    .collect();
+                (lobes, response.diffuse_transmittance * flux / std::f64::consts::PI)
+            });
+            let (lobes, diffuse) = per_bin.into_iter().unzip();
+            let transfer = SkyTransfer { lobes, diffuse };
             transfer
         })
     }

@@ -133,8 +133,10 @@ pub fn false_colour(lux: f32, top: f32) -> [f32; 3] {
 #[derive(Component, Clone, Copy, Default)]
 pub struct PhysicalUnits;
 
-/// The sun pass's lit surfaces and ray-query model of a scene (by address).
-type PerScene = (usize, Arc<Vec<f32>>, Arc<LightModel>);
+/// The active scene's ray-query model (no light gathered): its panel
+/// windows and their lobes, for the sun pass and the viewer's lobe arrows.
+#[derive(Resource, Clone)]
+pub struct RayModel(pub Arc<LightModel>);
 
 /// Rebuilds what the sun pass draws when the scene, sun or mode change.
 fn update_sun_pass(
@@ -142,19 +144,15 @@ fn update_sun_pass(
     sun_sky: Option<Res<SunSky>>,
     settings: Res<RenderSettings>,
     mut input: ResMut<SunPassInput>,
-    mut per_scene: Local<Option<PerScene>>,
+    mut commands: Commands,
+    mut per_scene: Local<Option<(usize, Arc<Vec<f32>>, Arc<LightModel>)>>,
     mut generation: Local<u64>,
 ) {
     let scene_changed = active.is_changed();
     if !scene_changed && !settings.is_changed() && !sun_sky.as_ref().is_some_and(|s| s.is_changed()) {
         return;
     }
-    let (Some(scene), Some(sun_sky)) = (&active.scene, sun_sky) else {
-        input.0 = None;
-        return;
-    };
-    let sun = sun_sky.sky.sun.filter(|s| s.direction.z > 0.0);
-    let Some(sun) = sun.filter(|_| settings.mode.draws_sun()) else {
+    let Some(scene) = &active.scene else {
         input.0 = None;
         return;
     };
@@ -166,8 +164,18 @@ fn update_sun_pass(
         _ => {
             let made = (Arc::new(lit_vertices(scene)), Arc::new(LightModel::unlit(scene.clone())));
             *per_scene = Some((scene_id, made.0.clone(), made.1.clone()));
+            commands.insert_resource(RayModel(made.1.clone()));
             made
         }
+    };
+    let Some(sun_sky) = sun_sky else {
+        input.0 = None;
+        return;
+    };
+    let sun = sun_sky.sky.sun.filter(|s| s.direction.z > 0.0);
+    let Some(sun) = sun.filter(|_| settings.mode.draws_sun()) else {
+        input.0 = None;
+        return;
     };
     *generation += 1;
     let frame = SunPassFrame::new(scene, &model, vertices, &sun, *generation);

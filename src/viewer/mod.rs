@@ -2,6 +2,7 @@
 //! ([`camera`]), drawn by [`crate::render::HeliodonRenderPlugin`].
 
 pub mod camera;
+pub mod lobes;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -30,7 +31,9 @@ impl Plugin for ViewerPlugin {
             Update,
             (frame_new_scene, exit_on_failed_load).after(HeliodonSystems::SpawnScene),
         )
-        .add_systems(Update, camera::navigate.after(frame_new_scene));
+        .add_systems(Update, camera::navigate.after(frame_new_scene))
+        .init_resource::<lobes::ShownLobes>()
+        .add_systems(Update, (lobes::select_panel_window, lobes::draw_lobes).chain().after(HeliodonSystems::UpdateSunSky));
     }
 }
 

@@ -53,8 +53,8 @@ impl PanelType for Venetian {
     }
 }
 
-/// Rays traced through one period.
-const RAYS: usize = 512;
+/// Rays traced through one period (evenly spaced: shares come in steps of 1/128).
+const RAYS: usize = 128;
 /// Bounces followed per ray; what is left is counted absorbed.
 const MAX_BOUNCES: usize = 32;
 /// Nominal angular width of a lobe (degrees): slats are never perfect mirrors.
@@ -95,20 +95,29 @@ impl VenetianModel {
         }
         let (y0, y1) = (origin.y + direction.y * t0, origin.y + direction.y * t1.min(1e3));
         let reach = half * along.y.abs() + 1e-9;
-        let k0 = ((y0.min(y1) - reach) / self.spacing).floor() as i64;
-        let k1 = ((y0.max(y1) + reach) / self.spacing).ceil() as i64;
         let denominator = direction.dot(normal);
         if denominator.abs() < 1e-12 {
             return None;
         }
-        (k0..=k1)
-            .filter_map(|k| {
-                let centre = DVec3::new(0.0, k as f64 * self.spacing, 0.0);
-                let t = (centre - origin).dot(normal) / denominator;
-                let along_slat = (origin + direction * t - centre).dot(along);
-                (t > 1e-9 && along_slat.abs() <= half).then_some(t)
-            })
-            .min_by(f64::total_cmp)
+        let hit = |k: i64| {
+            let centre = DVec3::new(0.0, k as f64 * self.spacing, 0.0);
+            let t = (centre - origin).dot(normal) / denominator;
+            let along_slat = (origin + direction * t - centre).dot(along);
+            (t > 1e-9 && along_slat.abs() <= half).then_some(t)
+        };
+        // Slats in the order the ray passes them; the first hit, checked
+        // against the next slat (tilted slats overlap in height), is the nearest.
+        let step: i64 = if direction.y >= 0.0 { 1 } else { -1 };
+        let first = ((y0 - step as f64 * reach) / self.spacing).floor() as i64 - step;
+        let last = ((y1 + step as f64 * reach) / self.spacing).floor() as i64 + 2 * step;
+        let mut k = first;
+        while (last - k) * step >= 0 {
+            if let Some(t) = hit(k) {
+                return Some(hit(k + step).map_or(t, |u| t.min(u)));
+            }
+            k += step;
+        }
+        None
     }
 }
 
