@@ -93,8 +93,7 @@ impl PanelGroup {
                 (lobes, response.diffuse_transmittance * flux / std::f64::consts::PI)
             });
             let (lobes, diffuse) = per_bin.into_iter().unzip();
-            let transfer = SkyTransfer { lobes, diffuse };
-            transfer
+            SkyTransfer { lobes, diffuse }
         })
     }
 

@@ -133,6 +133,9 @@ pub fn false_colour(lux: f32, top: f32) -> [f32; 3] {
 #[derive(Component, Clone, Copy, Default)]
 pub struct PhysicalUnits;
 
+/// The sun pass's lit surfaces and ray-query model of a scene (by address).
+type PerScene = (usize, Arc<Vec<f32>>, Arc<LightModel>);
+
 /// The active scene's ray-query model (no light gathered): its panel
 /// windows and their lobes, for the sun pass and the viewer's lobe arrows.
 #[derive(Resource, Clone)]
@@ -145,7 +148,7 @@ fn update_sun_pass(
     settings: Res<RenderSettings>,
     mut input: ResMut<SunPassInput>,
     mut commands: Commands,
-    mut per_scene: Local<Option<(usize, Arc<Vec<f32>>, Arc<LightModel>)>>,
+    mut per_scene: Local<Option<PerScene>>,
     mut generation: Local<u64>,
 ) {
     let scene_changed = active.is_changed();
