@@ -389,3 +389,49 @@ fn panel_lobes_are_drawn_where_the_engine_puts_them() {
         );
     }
 }
+
+/// The room with a 1 m deep overhang outside, 0.2 m above its window: at
+/// winter noon it shades the top quarter of the window from the sun.
+fn room_with_overhang(name: &str, window: &str) -> PathBuf {
+    let path = room(name, Some(window));
+    let obj_path = path.with_file_name("room.obj");
+    let mut obj = std::fs::read_to_string(&obj_path).unwrap();
+    let n = obj.lines().filter(|l| l.starts_with("v ")).count();
+    obj.push_str("usemtl wall\nv 0.5 0 2.2\nv 3.5 0 2.2\nv 3.5 -1.0 2.2\nv 0.5 -1.0 2.2\n");
+    obj.push_str(&format!("f {} {} {} {}\n", n + 1, n + 2, n + 3, n + 4));
+    std::fs::write(&obj_path, obj).unwrap();
+    path
+}
+
+/// Exterior shading acts on the real sun before the panel turns it into
+/// lobes: the overhang's shadow on a prismatic window keeps each lobe's
+/// light off part of the floor, in the engine and in the picture alike.
+#[test]
+fn an_overhang_shades_the_lobes_of_a_panel() {
+    use heliodon::render::offscreen::OffscreenRequest;
+    use heliodon::render::reference::compare_direct_sun;
+    use heliodon::render::{RenderMode, RenderSettings};
+    use heliodon::scene::Viewpoint;
+    use heliodon::time::{Date, LocalDateTime, TimeOfDay};
+    let path = room_with_overhang("overhang", "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n");
+    let view = Viewpoint { name: "floor".into(), eye: heliodon::glam::Vec3::new(2.0, 5.5, 2.5), target: heliodon::glam::Vec3::new(2.0, 2.0, 0.0), fov: 70.0 };
+    let request = OffscreenRequest {
+        scene: path.clone(),
+        view: Some(view),
+        width: 320,
+        height: 200,
+        when: Some(LocalDateTime { date: Date::new(2026, 12, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() }),
+        sky: Some(heliodon::sky::SkySpec::Clear { turbidity: 2.45 }),
+        settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
+        add_panels: all_panels,
+    };
+    let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sun_overhang_prismatic.png");
+    let result = compare_direct_sun(&request, &file).unwrap();
+    println!("overhang over a prismatic window: {result} -> {}", file.display());
+    assert!(result.lit > 1000, "{result}");
+    assert!(result.agreement >= 0.99 && result.within >= 0.99, "{result}");
+    // And the overhang does shade: the same view without it has more sun.
+    let open = OffscreenRequest { scene: room("no_overhang", Some("panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n")), ..request };
+    let unshaded = compare_direct_sun(&open, &file.with_file_name("sun_no_overhang_prismatic.png")).unwrap();
+    assert!(result.lit < unshaded.lit * 9 / 10, "{} lit with the overhang, {} without", result.lit, unshaded.lit);
+}

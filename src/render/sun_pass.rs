@@ -41,7 +41,7 @@ use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 
 use super::shadow_volume::shadow_volume;
 use crate::light::{Glass, LightModel};
-use crate::scene::{MaterialKind, Scene};
+use crate::scene::{MaterialKind, Scene, clip_convex};
 use crate::sky::SunSource;
 
 /// Depth bias of the opaque casters' caps, away from the camera (reverse Z:
@@ -145,12 +145,12 @@ impl SunPassFrame {
             volumes.extend(volume.sides);
             (caps.clone(), caps.end..volumes.len() as u32)
         };
-        let direction_pass = |direction: Vec3, volumes: &mut Vec<Vec4>| {
-            let (opaque_caps, opaque_sides) = add_volume(&opaque_casters, direction, volumes);
+        let direction_pass = |casters: &[[Vec3; 3]], direction: Vec3, volumes: &mut Vec<Vec4>| {
+            let (opaque_caps, opaque_sides) = add_volume(casters, direction, volumes);
             DirectionPass { opaque_caps, opaque_sides, all_windows: 0..0, lights: Vec::new() }
         };
         let to_sun = sun.direction.as_vec3();
-        let mut sun_pass = direction_pass(to_sun, &mut volumes);
+        let mut sun_pass = direction_pass(&opaque_casters, to_sun, &mut volumes);
         let windows_start = volumes.len() as u32;
         let mut aperture_volumes = Vec::new();
         for (_, panes, _) in &apertures {
@@ -174,9 +174,18 @@ impl SunPassFrame {
                     }
                 }
                 Key::Panel(group) => {
+                    // What shades the panel from the real sun outside casts
+                    // along each lobe too, from where it lies on the panel.
+                    let shadows = shadows_on(panes, *normal, &opaque_casters, to_sun);
+                    // A lobe's light starts at the panel: only what lies on
+                    // the room side of it casts along the lobe.
+                    let inside = normal * -to_sun.dot(*normal).signum();
+                    let inner_casters = beside(&opaque_casters, panes[0][0], inside);
                     for beam in beams.iter().filter(|b| b.panel_group == Some(*group)) {
                         let direction = beam.to_light.as_vec3();
-                        let mut pass = direction_pass(direction, &mut volumes);
+                        let mut pass = direction_pass(&inner_casters, direction, &mut volumes);
+                        let (_, shadow_sides) = add_volume(&shadows, direction, &mut volumes);
+                        pass.opaque_sides.end = shadow_sides.end;
                         let (caps, sides) = add_volume(panes, direction, &mut volumes);
                         pass.lights.push(SunLight { direction, irradiance: beam.normal_irradiance as f32, aperture: Some(caps.start..sides.end) });
                         lobe_passes.push(pass);
@@ -202,6 +211,61 @@ impl SunPassFrame {
     pub fn draw_count(&self) -> usize {
         1 + self.passes.iter().map(|p| 2 + p.lights.iter().map(|l| if l.aperture.is_some() { 3 } else { 2 }).sum::<usize>()).sum::<usize>()
     }
+}
+
+/// The shadows `casters` throw on a window's `panes` (a plane with
+/// `normal`) under the sun along `to_sun`: each caster between the window
+/// and the sun, projected along the sun onto the window's plane and clipped
+/// to each pane (panes are triangles, hence convex). As casters along a
+/// lobe, they keep its light from the shaded part of the panel.
+fn shadows_on(panes: &[[Vec3; 3]], normal: Vec3, casters: &[[Vec3; 3]], to_sun: Vec3) -> Vec<[Vec3; 3]> {
+    let Some(origin) = panes.first().map(|p| p[0]) else { return Vec::new() };
+    let toward = to_sun.dot(normal);
+    if toward.abs() < 1e-6 {
+        return Vec::new();
+    }
+    // The sun's side of the plane: `above` along `side`.
+    let side = normal * toward.signum();
+    let (lo, hi) = panes.iter().flatten().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let mut out = Vec::new();
+    for in_front in beside(casters, origin, side) {
+        // Along the sun onto the plane.
+        let projected: Vec<Vec3> = in_front.iter().map(|&p| p - to_sun * ((p - origin).dot(normal) / toward)).collect();
+        let (plo, phi) = projected.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        if plo.cmpgt(hi + 1e-4).any() || phi.cmplt(lo - 1e-4).any() {
+            continue;
+        }
+        for pane in panes {
+            // Inside a pane: on the inner side of each of its edges' planes.
+            let pane_normal = (pane[1] - pane[0]).cross(pane[2] - pane[0]);
+            let mut polygon = projected.clone();
+            for k in 0..3 {
+                let (a, b) = (pane[k], pane[(k + 1) % 3]);
+                let inward = pane_normal.cross(b - a);
+                polygon = clip_convex(&polygon, inward, a.dot(inward), true);
+                if polygon.len() < 3 {
+                    break;
+                }
+            }
+            for k in 1..polygon.len().saturating_sub(1) {
+                out.push([polygon[0], polygon[k], polygon[k + 1]]);
+            }
+        }
+    }
+    out
+}
+
+/// The parts of `casters` strictly on the `side` of the plane through
+/// `origin` (as triangles).
+fn beside(casters: &[[Vec3; 3]], origin: Vec3, side: Vec3) -> Vec<[Vec3; 3]> {
+    let mut out = Vec::new();
+    for caster in casters {
+        let polygon = clip_convex(&caster[..], side, origin.dot(side) + 1e-4, true);
+        for k in 1..polygon.len().saturating_sub(1) {
+            out.push([polygon[0], polygon[k], polygon[k + 1]]);
+        }
+    }
+    out
 }
 
 /// The diffuse surfaces as the sun pass draws them: the very triangles of

@@ -12,6 +12,7 @@ mod frame;
 mod material;
 mod obj;
 mod patches;
+pub(crate) use patches::clip as clip_convex;
 mod sensors;
 mod surfaces;
 

@@ -133,7 +133,7 @@ fn plane_axes(normal: Vec3) -> (Vec3, Vec3) {
 
 /// Sutherland–Hodgman: the part of a convex polygon on one side of the plane
 /// `p·axis = bound`.
-fn clip(polygon: &[Vec3], axis: Vec3, bound: f32, keep_above: bool) -> Vec<Vec3> {
+pub(crate) fn clip(polygon: &[Vec3], axis: Vec3, bound: f32, keep_above: bool) -> Vec<Vec3> {
     let side = |p: Vec3| if keep_above { p.dot(axis) - bound } else { bound - p.dot(axis) };
     let mut out = Vec::with_capacity(polygon.len() + 1);
     for (k, &current) in polygon.iter().enumerate() {
