@@ -211,7 +211,12 @@ struct SensorGeometry {
 /// Irradiance (W/m²) on a patch side or sensor, by channel.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Channels {
+    /// All direct sunlight: straight, along panel lobes, and transmitted
+    /// diffusely by panels.
     pub sun: f64,
+    /// The part of `sun` that panels transmit diffusely (the renderer draws
+    /// it with the patches, not with the sun pass).
+    pub sun_diffuse: f64,
     /// Sky and ground glow.
     pub sky: f64,
     /// Interreflected, RGB.
@@ -580,6 +585,8 @@ impl LightModel {
         let sun = sky.sun.filter(|s| s.direction.z > 0.0);
         let seen = self.key_radiance(sky);
         let sky_irradiance = |g: &Gather| PI * g.bins.iter().map(|&(k, w)| f64::from(w) * seen.of(k)).sum::<f64>();
+        // Sunlight that panels transmit diffusely, seen through them.
+        let panel_sun = |g: &Gather| PI * g.bins.iter().map(|&(k, w)| f64::from(w) * seen.sun_of(k)).sum::<f64>();
         let beams = sun.map(|s| self.sun_beams(&s)).unwrap_or_default();
         let direct: Vec<Channels> = par_map(self.settings.threads, patches.len() * 2, |side| {
             let gather = &self.side_gathers[side];
@@ -588,13 +595,14 @@ impl LightModel {
                 return Channels::default();
             }
             let normal = patch.normal.as_dvec3() * if side % 2 == 1 { -1.0 } else { 1.0 };
-            let mut channels = Channels { sky: sky_irradiance(gather), ..Default::default() };
+            let diffuse_sun = panel_sun(gather);
+            let mut channels = Channels { sky: sky_irradiance(gather), sun: diffuse_sun, sun_diffuse: diffuse_sun, ..Default::default() };
             if beams.iter().any(|b| normal.dot(b.to_light) > 0.0) {
                 let triangles = self.patch_triangles(side / 2);
                 let mut rng = Rng::new(3, side as u64);
                 let n = self.settings.sun_samples_per_patch;
                 let total: f64 = (0..n).map(|_| self.beams_irradiance(sample_area(&triangles, &mut rng), normal, &beams)).sum();
-                channels.sun = total / n as f64;
+                channels.sun += total / n as f64;
             }
             channels
         });
@@ -607,12 +615,12 @@ impl LightModel {
         // Each sensor's direct light and the first bounce of sun where its rays land.
         let sensors: Vec<SensorDirect> = par_map(self.settings.threads, self.sensors.len(), |i| {
             let geometry = &self.sensors[i];
-            let mut out = SensorDirect { sky: sky_irradiance(&geometry.gather), ..Default::default() };
+            let mut out = SensorDirect { sky: sky_irradiance(&geometry.gather), sun: panel_sun(&geometry.gather), ..Default::default() };
             if beams.is_empty() {
                 return out;
             }
             let total: f64 = geometry.sun_points.iter().map(|&p| self.beams_irradiance(p, geometry.normal, &beams)).sum();
-            out.sun = total / geometry.sun_points.len() as f64;
+            out.sun += total / geometry.sun_points.len() as f64;
             for &(j, w, point) in &geometry.hits {
                 let side_normal = self.patch_normal(j / 2) * if j % 2 == 1 { -1.0 } else { 1.0 };
                 if beams.iter().any(|b| side_normal.dot(b.to_light) > 0.0) {
@@ -648,19 +656,28 @@ struct KeyRadiance {
     bin_count: u32,
     /// Per sphere bin.
     bins: Vec<f64>,
-    /// Per panel group, per sphere bin: seen through its windows.
+    /// Per panel group, per sphere bin: sky and ground seen through its windows.
     panels: Vec<Vec<f64>>,
+    /// Per panel group: its diffusely transmitted sunlight's radiance.
+    panel_sun: Vec<f64>,
     /// Per scene window: its panel group.
     window_panel: Vec<Option<u32>>,
 }
 
 impl KeyRadiance {
+    /// Sky and ground radiance behind `key`.
     fn of(&self, key: u32) -> f64 {
         let key = SkyKey::unpack(key, self.bin_count);
         match key.window.and_then(|w| self.window_panel[w as usize]) {
             Some(group) => self.panels[group as usize][key.bin as usize],
             None => self.bins[key.bin as usize],
         }
+    }
+
+    /// Diffusely transmitted sunlight behind `key` (through panels only).
+    fn sun_of(&self, key: u32) -> f64 {
+        let key = SkyKey::unpack(key, self.bin_count);
+        key.window.and_then(|w| self.window_panel[w as usize]).map_or(0.0, |group| self.panel_sun[group as usize])
     }
 }
 
@@ -824,9 +841,10 @@ impl LightModel {
         let mut bins = Vec::with_capacity(self.bin_count() as usize);
         self.bins.integrate_sphere_into(sky, &mut bins);
         let sun = sky.sun.filter(|s| s.direction.z > 0.0);
-        let panels = self.panel_groups.iter().map(|g| g.radiance_through(&self.bins, &bins, sun.as_ref())).collect();
+        let panels = self.panel_groups.iter().map(|g| g.radiance_through(&self.bins, &bins)).collect();
+        let panel_sun = self.panel_groups.iter().map(|g| g.sun_diffuse_radiance(sun.as_ref())).collect();
         let window_panel = self.scene.windows.iter().map(|w| self.group_of_surface[w.surface as usize]).collect();
-        KeyRadiance { bin_count: self.bin_count(), bins, panels, window_panel }
+        KeyRadiance { bin_count: self.bin_count(), bins, panels, panel_sun, window_panel }
     }
 
     /// Sensors that seem to sit inside a solid: every ray from them meets a

@@ -97,10 +97,9 @@ impl PanelGroup {
         })
     }
 
-    /// Radiance (W/sr/m²) seen through the group's windows in every sphere
-    /// bin, for bin radiances `sky` and the sun (whose lobes are beams of
-    /// their own; its diffuse transmission is added here).
-    pub fn radiance_through(&self, bins: &SkyPatches, sky: &[f64], sun: Option<&SunSource>) -> Vec<f64> {
+    /// Radiance (W/sr/m²) of sky and ground light seen through the group's
+    /// windows in every sphere bin, for bin radiances `sky`.
+    pub fn radiance_through(&self, bins: &SkyPatches, sky: &[f64]) -> Vec<f64> {
         let transfer = self.sky_transfer(bins);
         let mut out = vec![0.0; sky.len()];
         let mut diffuse = 0.0;
@@ -113,14 +112,20 @@ impl PanelGroup {
             }
             diffuse += transfer.diffuse[b] * radiance;
         }
-        if let Some(sun) = sun.filter(|s| s.direction.z > 0.0) {
-            let incoming = self.frame.to_panel(-sun.direction);
-            if incoming.z > 0.0 {
-                diffuse += sun.normal_irradiance() * incoming.z * self.model.response(incoming).diffuse_transmittance / std::f64::consts::PI;
-            }
-        }
         out.iter_mut().for_each(|r| *r += diffuse);
         out
+    }
+
+    /// Radiance (W/sr/m²) of the sunlight the group's windows transmit
+    /// diffusely (their lobes are beams of their own): sunlight redirected
+    /// by the panel, so it counts as direct sun.
+    pub fn sun_diffuse_radiance(&self, sun: Option<&SunSource>) -> f64 {
+        let Some(sun) = sun.filter(|s| s.direction.z > 0.0) else { return 0.0 };
+        let incoming = self.frame.to_panel(-sun.direction);
+        if incoming.z <= 0.0 {
+            return 0.0;
+        }
+        sun.normal_irradiance() * incoming.z * self.model.response(incoming).diffuse_transmittance / std::f64::consts::PI
     }
 }
 

@@ -253,7 +253,7 @@ fn metered_luminance(scene: &Scene, model: &LightModel, sides: &[Channels], came
             continue;
         }
         let channels = sides.get(side_of(p as u32, back) as usize)?;
-        let with_sun = Channels { sky: channels.sky + channels.sun, ..*channels };
+        let with_sun = Channels { sky: channels.sky + channels.sun, sun_diffuse: 0.0, ..*channels };
         let [r, g, b] = side_value(&with_sun, reflectance.0, RenderMode::Full);
         let luminance = f64::from(0.265 * r + 0.670 * g + 0.065 * b);
         if luminance > 1e-3 {

@@ -235,7 +235,8 @@ pub fn side_value(channels: &Channels, reflectance: [f32; 3], mode: RenderMode) 
         [0, 1, 2].map(|c| (f64::from(reflectance[c]) / PI * irradiance[c] * LUMINOUS_EFFICACY) as f32)
     };
     match mode {
-        RenderMode::Full => luminance(channels.indirect.map(|i| i + channels.sky)),
+        // The sun pass draws the sun's beams; panels' diffuse sunlight is drawn here.
+        RenderMode::Full => luminance(channels.indirect.map(|i| i + channels.sky + channels.sun_diffuse)),
         RenderMode::Sun => [0.0; 3],
         RenderMode::Sky => luminance([channels.sky; 3]),
         RenderMode::Indirect => luminance(channels.indirect),
