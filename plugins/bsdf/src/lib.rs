@@ -279,6 +279,41 @@ mod tests {
         }
     }
 
+    /// A Klems quarter basis (41 patches) file written here: clear glass of
+    /// 0.8 transmittance (diagonal BSDF 0.8 / projected solid angle).
+    fn quarter_basis_glass() -> String {
+        let rings = [(0.0, 9.0, 1), (9.0, 27.0, 8), (27.0, 46.0, 12), (46.0, 66.0, 12), (66.0, 90.0, 8)];
+        let mut blocks = String::new();
+        let mut projected = Vec::new();
+        for (lo, hi, phis) in rings {
+            blocks.push_str(&format!(
+                "<AngleBasisBlock><Theta>{}</Theta><nPhis>{phis}</nPhis><ThetaBounds><LowerTheta>{lo}</LowerTheta><UpperTheta>{hi}</UpperTheta></ThetaBounds></AngleBasisBlock>\n",
+                0.5 * (lo + hi)
+            ));
+            let (l, h): (f64, f64) = (f64::to_radians(lo), f64::to_radians(hi));
+            projected.extend(std::iter::repeat_n(std::f64::consts::PI * (l.cos().powi(2) - h.cos().powi(2)) / phis as f64, phis));
+        }
+        let n = projected.len();
+        let values: Vec<String> = (0..n * n).map(|k| if k / n == k % n { format!("{}", 0.8 / projected[k % n]) } else { "0".into() }).collect();
+        format!(
+            "<?xml version=\"1.0\"?>\n<WindowElement><Optical><Layer><DataDefinition><IncidentDataStructure>Columns</IncidentDataStructure>\n<AngleBasis><AngleBasisName>LBNL/Klems Quarter</AngleBasisName>\n{blocks}</AngleBasis></DataDefinition>\n<WavelengthData><Wavelength unit=\"Integral\">Visible</Wavelength><WavelengthDataBlock><WavelengthDataDirection>Transmission Front</WavelengthDataDirection><ColumnAngleBasis>LBNL/Klems Quarter</ColumnAngleBasis><RowAngleBasis>LBNL/Klems Quarter</RowAngleBasis><ScatteringDataType>BTDF</ScatteringDataType><ScatteringData>{}</ScatteringData></WavelengthDataBlock></WavelengthData>\n</Layer></Optical></WindowElement>\n",
+            values.join(",")
+        )
+    }
+
+    #[test]
+    fn a_quarter_basis_file_reads_and_fits() {
+        let file = xml::parse(&quarter_basis_glass(), Path::new("quarter.xml")).unwrap();
+        assert_eq!(file.basis.len(), 41);
+        let model = BsdfModel::fit(&file, 3, 23.0);
+        assert!((model.captured - 1.0).abs() < 1e-9, "{}", model.captured);
+        // At a measured direction, one lobe straight through with 0.8 of the light.
+        let d = klems_patches(&file.basis)[5].0;
+        let r = model.response(d);
+        assert!(r.lobes[0].direction.angle_between(d) < 1e-6 && (r.lobes[0].share - 0.8).abs() < 1e-9, "{:?}", r.lobes);
+        assert!((r.absorbed - 0.2).abs() < 1e-9);
+    }
+
     #[test]
     fn malformed_files_give_clear_errors() {
         let text = std::fs::read_to_string(sample("clear.xml")).unwrap();
