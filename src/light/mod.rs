@@ -742,10 +742,13 @@ impl Relight<'_> {
     }
 
     /// Radiant exitance of each side (RGB), with or without its direct sun.
+    /// Without the sun's beams (sensors take their first bounce where their
+    /// rays land), the panels' diffuse sunlight still counts.
     fn leaving(&self, with_sun: bool) -> Vec<[f64; 3]> {
         (0..self.direct.len())
             .map(|j| {
-                let e = if with_sun { self.direct[j].sun } else { 0.0 } + self.direct[j].sky;
+                let sun = if with_sun { self.direct[j].sun } else { self.direct[j].sun_diffuse };
+                let e = sun + self.direct[j].sky;
                 [0, 1, 2].map(|c| self.reflectance[j][c] * (e + self.indirect[j][c]))
             })
             .collect()
