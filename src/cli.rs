@@ -37,10 +37,8 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Open the interactive viewer
-    View {
-        /// Scene file (TOML); the bundled example when absent
-        scene: Option<PathBuf>,
-    },
+    #[command(allow_negative_numbers = true)]
+    View(ViewArgs),
     /// Print a summary of a scene: geometry, patches, materials, windows, sensors, site
     Info {
         /// Scene file (TOML)
@@ -58,6 +56,23 @@ pub enum Command {
     /// Sun position (NREL SPA) for a site and a local standard time, or the day's sunrise, noon and sunset
     #[command(allow_negative_numbers = true)]
     Sun(SunArgs),
+}
+
+#[derive(clap::Args, Debug)]
+pub struct ViewArgs {
+    /// Scene file (TOML); the bundled example when absent
+    pub scene: Option<PathBuf>,
+    /// Wait until the light has converged, save the window (with its panels) to FILE and exit
+    #[arg(long, value_name = "FILE")]
+    pub screenshot: Option<PathBuf>,
+    /// Local date, YYYY-MM-DD
+    #[arg(long, value_parser = Date::parse)]
+    pub date: Option<Date>,
+    /// Local standard time, HH:MM
+    #[arg(long, value_parser = TimeOfDay::parse)]
+    pub time: Option<TimeOfDay>,
+    #[command(flatten)]
+    pub sky: SkyArgs,
 }
 
 #[derive(clap::Args, Debug)]
@@ -265,10 +280,14 @@ pub fn main(add_panels: AddPanels) -> ExitCode {
         }
     };
     match cli.command {
-        None => crate::viewer::run(cli.scene.unwrap_or_else(|| crate::bundled_scene(crate::DEFAULT_SCENE)), add_panels),
-        Some(Command::View { scene }) => {
-            crate::viewer::run(scene.unwrap_or_else(|| crate::bundled_scene(crate::DEFAULT_SCENE)), add_panels)
-        }
+        None => crate::viewer::run(cli.scene.unwrap_or_else(|| crate::bundled_scene(crate::DEFAULT_SCENE)), add_panels, None),
+        Some(Command::View(args)) => match view_request(&args) {
+            Ok(start) => crate::viewer::run(args.scene.clone().unwrap_or_else(|| crate::bundled_scene(crate::DEFAULT_SCENE)), add_panels, Some(start)),
+            Err(error) => {
+                eprintln!("error: {error}");
+                ExitCode::from(2)
+            }
+        },
         Some(Command::Info { scene }) => match scene::load_scene(&scene, &panels) {
             Ok(loaded) => {
                 for warning in &loaded.warnings {
@@ -349,6 +368,15 @@ pub fn export_radiance(args: &ExportArgs, panels: &PanelCatalog) -> Result<(), S
         when.date, when.time, args.sky.sky, position.altitude, position.azimuth
     );
     crate::radiance::export(&scene, &sky, &case, &args.out)
+}
+
+/// How `view` starts: the time and sky given, and where to save a screenshot.
+fn view_request(args: &ViewArgs) -> Result<crate::viewer::ViewStart, String> {
+    let sky = if args.sky.sky != "clear" || args.sky.turbidity.is_some() { Some(args.sky.spec()?) } else { None };
+    let default = crate::ecs::SolarTime::default().0;
+    let when = (args.date.is_some() || args.time.is_some())
+        .then(|| LocalDateTime { date: args.date.unwrap_or(default.date), time: args.time.unwrap_or(default.time) });
+    Ok(crate::viewer::ViewStart { screenshot: args.screenshot.clone(), when, sky })
 }
 
 /// The `render` command.

@@ -56,6 +56,7 @@ impl CadCamera {
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 pub fn navigate(
     mouse: Res<ButtonInput<MouseButton>>,
     keys: Res<ButtonInput<KeyCode>>,
@@ -63,8 +64,13 @@ pub fn navigate(
     scroll: Res<AccumulatedMouseScroll>,
     window: Single<&Window, With<PrimaryWindow>>,
     active: Res<ActiveScene>,
+    ui: Option<Res<super::ui::UiState>>,
     mut cameras: Query<(&mut CadCamera, &mut Transform, &Camera, &GlobalTransform, &Projection)>,
 ) {
+    // The pointer over a panel belongs to the panel.
+    if ui.is_some_and(|ui| ui.pointer_over_panels) {
+        return;
+    }
     for (mut cad, mut transform, camera, global, projection) in &mut cameras {
         let fov = match projection {
             Projection::Perspective(p) => p.fov,

@@ -1,8 +1,12 @@
 //! The interactive viewer: a window on a scene with the CAD camera
-//! ([`camera`]), drawn by [`crate::render::HeliodonRenderPlugin`].
+//! ([`camera`]), the designer's panels ([`ui`]) and panel lobes
+//! ([`lobes`]), drawn by [`crate::render::HeliodonRenderPlugin`]. With a
+//! screenshot request it waits for the light to converge, saves the window
+//! and exits (`heliodon view SCENE --screenshot FILE`).
 
 pub mod camera;
 pub mod lobes;
+pub mod ui;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -18,6 +22,15 @@ pub struct ViewerPlugin {
     pub scene: PathBuf,
 }
 
+/// How `view` starts: the time and sky to show and, for `--screenshot`,
+/// where to save the window once the light has converged.
+#[derive(Resource, Debug, Clone)]
+pub struct ViewStart {
+    pub screenshot: Option<PathBuf>,
+    pub when: Option<crate::time::LocalDateTime>,
+    pub sky: Option<crate::sky::SkySpec>,
+}
+
 impl Plugin for ViewerPlugin {
     fn build(&self, app: &mut App) {
         let scene = self.scene.clone();
@@ -31,14 +44,18 @@ impl Plugin for ViewerPlugin {
             Update,
             (frame_new_scene, exit_on_failed_load).after(HeliodonSystems::SpawnScene),
         )
+        .add_plugins(ui::DesignerUiPlugin)
         .add_systems(Update, camera::navigate.after(frame_new_scene))
+        .add_systems(Startup, apply_view_start)
+        .add_systems(Update, take_screenshot.after(HeliodonSystems::Lighting))
         .init_resource::<lobes::ShownLobes>()
         .add_systems(Update, (lobes::select_panel_window, lobes::draw_lobes).chain().after(HeliodonSystems::UpdateSunSky));
     }
 }
 
-/// Opens the window on a scene; returns when the window closes.
-pub fn run(scene: PathBuf, add_panels: crate::ecs::AddPanels) -> ExitCode {
+/// Opens the window on a scene; returns when the window closes (or, with
+/// `screenshot`, once it is saved).
+pub fn run(scene: PathBuf, add_panels: crate::ecs::AddPanels, start: Option<ViewStart>) -> ExitCode {
     let title = format!("heliodon — {}", scene.display());
     let mut app = App::new();
     app.add_plugins(
@@ -51,6 +68,9 @@ pub fn run(scene: PathBuf, add_panels: crate::ecs::AddPanels) -> ExitCode {
         )
         .add_plugins((HeliodonPlugins, HeliodonRenderPlugin, ViewerPlugin { scene }));
     add_panels(&mut app);
+    if let Some(request) = start {
+        app.insert_resource(request);
+    }
     let exit = app.run();
     match exit {
         AppExit::Success => ExitCode::SUCCESS,
@@ -71,6 +91,61 @@ fn frame_new_scene(
     for (mut cad, mut projection) in &mut cameras {
         *cad = CadCamera::from_viewpoint(&view);
         *projection = Projection::Perspective(PerspectiveProjection { fov: view.fov.to_radians(), ..default() });
+    }
+}
+
+fn apply_view_start(request: Option<Res<ViewStart>>, mut time: ResMut<crate::ecs::SolarTime>, mut sky: ResMut<crate::ecs::SkyChoice>) {
+    let Some(request) = request else { return };
+    if let Some(when) = request.when {
+        time.0 = when;
+    }
+    if let Some(spec) = request.sky.clone() {
+        sky.0 = spec;
+    }
+}
+
+/// Frames drawn after the light converges before the window is saved.
+const SETTLE_FRAMES: u32 = 10;
+
+/// Saves the window once the light has converged, then exits.
+fn take_screenshot(
+    mut commands: Commands,
+    request: Option<Res<ViewStart>>,
+    lighting: Option<Res<crate::ecs::LightingState>>,
+    mut frames: Local<u32>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    let Some(path) = request.and_then(|r| r.screenshot.clone()) else { return };
+    if !lighting.is_some_and(|l| l.converged) {
+        *frames = 0;
+        return;
+    }
+    *frames += 1;
+    if *frames == SETTLE_FRAMES {
+        commands.spawn(bevy::render::view::screenshot::Screenshot::primary_window()).observe(
+            move |captured: On<bevy::render::view::screenshot::ScreenshotCaptured>, mut exit: MessageWriter<AppExit>| {
+                let saved = captured
+                    .image
+                    .clone()
+                    .try_into_dynamic()
+                    .map_err(|e| e.to_string())
+                    .and_then(|image| image.to_rgb8().save(&path).map_err(|e| e.to_string()));
+                match saved {
+                    Ok(()) => {
+                        exit.write(AppExit::Success);
+                    }
+                    Err(error) => {
+                        eprintln!("error: {}: cannot save the screenshot: {error}", path.display());
+                        exit.write(AppExit::error());
+                    }
+                }
+            },
+        );
+    }
+    // A screenshot that never arrives must not keep the viewer open forever.
+    if *frames > SETTLE_FRAMES + 600 {
+        eprintln!("error: the screenshot was not captured");
+        exit.write(AppExit::error());
     }
 }
 

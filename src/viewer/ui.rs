@@ -1,0 +1,374 @@
+//! [`DesignerUiPlugin`]: the designer's panels (bevy_egui). Left: the sun
+//! and sky (date, time, play, site with a sun-path diagram, sky type and
+//! parameters, exposure). Right: the view (modes, the light's progress) and
+//! a live table of the sensors. The 3D view fills the space between them:
+//! the camera's viewport follows the panels, and the pointer over a panel
+//! belongs to the panel.
+
+use bevy::camera::visibility::RenderLayers;
+use bevy::camera::{CameraOutputMode, Viewport};
+use bevy::prelude::*;
+use bevy::render::render_resource::BlendState;
+use bevy::window::PrimaryWindow;
+use bevy_egui::egui::{self, LayerId, Ui, UiBuilder};
+use bevy_egui::{EguiContexts, EguiGlobalSettings, EguiPlugin, EguiPrimaryContextPass, PrimaryEguiContext};
+
+use crate::ecs::{LightEngine, LightingState, Site, SkyChoice, SolarTime, SunSky};
+use crate::render::sun_pass::SunPassView;
+use crate::render::{RenderMode, RenderSettings};
+use crate::sky::perez;
+use crate::sky::SkySpec;
+use crate::sun::solar_position;
+use crate::time::{Date, LocalDateTime, TimeOfDay, days_in_month};
+
+pub struct DesignerUiPlugin;
+
+impl Plugin for DesignerUiPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_plugins(EguiPlugin::default())
+            .init_resource::<UiState>()
+            .add_systems(Startup, spawn_ui_camera)
+            .add_systems(EguiPrimaryContextPass, panels)
+            .add_systems(Update, play_the_day);
+    }
+}
+
+/// What the panels keep between frames.
+#[derive(Resource, Debug, Clone, Default)]
+pub struct UiState {
+    /// The day plays: hours of solar time per second.
+    pub playing: Option<f64>,
+    /// Whether the pointer is over a panel (the camera then ignores it).
+    pub pointer_over_panels: bool,
+    /// Last clamped input, shown under the panel until the next change.
+    pub note: Option<String>,
+}
+
+/// The panels are drawn by a camera of their own over the whole window.
+fn spawn_ui_camera(mut commands: Commands, mut settings: ResMut<EguiGlobalSettings>) {
+    settings.auto_create_primary_context = false;
+    commands.spawn((
+        PrimaryEguiContext,
+        Camera2d,
+        RenderLayers::none(),
+        Camera {
+            order: 10,
+            output_mode: CameraOutputMode::Write { blend_state: Some(BlendState::ALPHA_BLENDING), clear_color: ClearColorConfig::None },
+            clear_color: ClearColorConfig::Custom(Color::NONE),
+            ..default()
+        },
+    ));
+}
+
+fn play_the_day(time: Res<Time>, ui: Res<UiState>, mut solar: ResMut<SolarTime>) {
+    let Some(speed) = ui.playing else { return };
+    let mut hours = solar.0.time.hours() + speed * f64::from(time.delta_secs());
+    let mut date = solar.0.date;
+    if hours >= 24.0 {
+        hours -= 24.0;
+        date = date.add_days(1);
+    }
+    if let Ok(time) = TimeOfDay::from_hours(hours) {
+        solar.0 = LocalDateTime { date, time };
+    }
+}
+
+/// The quick dates: equinoxes and solstices.
+const QUICK_DATES: [(&str, u32, u32); 4] = [("Mar 21", 3, 21), ("Jun 21", 6, 21), ("Sep 23", 9, 23), ("Dec 21", 12, 21)];
+
+#[allow(clippy::too_many_arguments)]
+fn panels(
+    mut contexts: EguiContexts,
+    mut ui_state: ResMut<UiState>,
+    mut solar: ResMut<SolarTime>,
+    mut sky: ResMut<SkyChoice>,
+    mut settings: ResMut<RenderSettings>,
+    site: Option<ResMut<Site>>,
+    sun_sky: Option<Res<SunSky>>,
+    lighting: Option<Res<LightingState>>,
+    engine: Option<Res<LightEngine>>,
+    window: Single<&Window, With<PrimaryWindow>>,
+    mut cameras: Query<&mut Camera, With<SunPassView>>,
+) -> Result {
+    let ctx = contexts.ctx_mut()?.clone();
+    let mut root = Ui::new(ctx.clone(), "viewport".into(), UiBuilder::new().layer_id(LayerId::background()).max_rect(ctx.viewport_rect()));
+    let left = egui::Panel::left("sun_and_sky")
+        .default_size(270.0)
+        .show(&mut root, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                sun_and_sky_panel(ui, &mut ui_state, &mut solar, &mut sky, &mut settings, site, sun_sky.as_deref());
+            });
+        })
+        .response
+        .rect
+        .width();
+    let right = egui::Panel::right("view_and_sensors")
+        .default_size(330.0)
+        .show(&mut root, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                view_panel(ui, &mut settings, lighting.as_deref(), engine.as_deref());
+            });
+        })
+        .response
+        .rect
+        .width();
+    ui_state.pointer_over_panels = ctx.is_pointer_over_egui();
+    // The 3D view: what the panels leave.
+    let scale = window.scale_factor();
+    let (left, right) = ((left * scale) as u32, (right * scale) as u32);
+    let width = window.physical_width().saturating_sub(left + right).max(1);
+    let viewport = Viewport { physical_position: UVec2::new(left, 0), physical_size: UVec2::new(width, window.physical_height().max(1)), ..default() };
+    for mut camera in &mut cameras {
+        let same = camera.viewport.as_ref().is_some_and(|v| v.physical_position == viewport.physical_position && v.physical_size == viewport.physical_size);
+        if !same {
+            camera.viewport = Some(viewport.clone());
+        }
+    }
+    Ok(())
+}
+
+// Resources are passed as `ResMut` and written only when a value changes:
+// writing marks them changed, and a changed time or sky starts a relight.
+fn sun_and_sky_panel(
+    ui: &mut Ui,
+    state: &mut UiState,
+    solar: &mut ResMut<SolarTime>,
+    sky: &mut ResMut<SkyChoice>,
+    settings: &mut ResMut<RenderSettings>,
+    site: Option<ResMut<Site>>,
+    sun_sky: Option<&SunSky>,
+) {
+    ui.heading("Sun and sky");
+    let LocalDateTime { mut date, time } = solar.0;
+    // Day of the year as a slider for browsing, the date as spinners for exact input.
+    let days = if days_in_month(date.year, 2) == 29 { 366 } else { 365 };
+    let mut day = date.day_of_year();
+    ui.label(format!("Date: {date}"));
+    if ui.add(egui::Slider::new(&mut day, 1..=days).text("day of year")).changed() {
+        date = Date::new(date.year, 1, 1).expect("1 January").add_days(i64::from(day) - 1);
+    }
+    ui.horizontal(|ui| {
+        let mut year = date.year;
+        let mut month = date.month;
+        let mut day = date.day;
+        let y = ui.add(egui::DragValue::new(&mut year).range(1900..=2100)).changed();
+        let m = ui.add(egui::DragValue::new(&mut month).range(1..=12)).changed();
+        let d = ui.add(egui::DragValue::new(&mut day).range(1..=31)).changed();
+        if y || m || d {
+            let last = days_in_month(year, month);
+            if day > last {
+                state.note = Some(format!("day {day} clamped to {last}: {year}-{month:02} has {last} days"));
+                day = last;
+            }
+            if let Ok(new) = Date::new(year, month, day) {
+                date = new;
+            }
+        }
+    });
+    ui.horizontal(|ui| {
+        for (label, month, day) in QUICK_DATES {
+            if ui.button(label).clicked() {
+                date = Date::new(date.year, month, day).expect("quick date");
+            }
+        }
+    });
+    let mut minutes = (time.hours() * 60.0).round() as i64;
+    ui.add(egui::Slider::new(&mut minutes, 0..=1439).text("time").custom_formatter(|m, _| format!("{:02}:{:02}", m as i64 / 60, m as i64 % 60)));
+    ui.horizontal(|ui| {
+        ui.label("exact");
+        ui.add(
+            egui::DragValue::new(&mut minutes)
+                .range(0..=1439)
+                .custom_formatter(|m, _| format!("{:02}:{:02}", m as i64 / 60, m as i64 % 60))
+                .custom_parser(|text| {
+                    let (h, m) = text.split_once(':')?;
+                    Some((h.trim().parse::<f64>().ok()? * 60.0 + m.trim().parse::<f64>().ok()?).clamp(0.0, 1439.0))
+                }),
+        );
+        let label = if state.playing.is_some() { "Pause" } else { "Play the day" };
+        if ui.button(label).clicked() {
+            state.playing = if state.playing.is_some() { None } else { Some(0.5) };
+        }
+    });
+    let time = TimeOfDay::from_hours(minutes as f64 / 60.0).unwrap_or(time);
+    let new = LocalDateTime { date, time };
+    if new != solar.0 {
+        solar.0 = new;
+    }
+    if let Some(sun_sky) = sun_sky {
+        ui.label(format!("Sun: altitude {:.1}°, azimuth {:.1}°", sun_sky.sun.altitude, sun_sky.sun.azimuth));
+    }
+    ui.separator();
+    if let Some(mut site) = site {
+        ui.label("Site");
+        let mut s = site.0;
+        ui.horizontal(|ui| {
+            ui.add(egui::DragValue::new(&mut s.latitude).range(-90.0..=90.0).speed(0.1).prefix("lat "));
+            ui.add(egui::DragValue::new(&mut s.longitude).range(-180.0..=180.0).speed(0.1).prefix("lon "));
+        });
+        ui.add(egui::DragValue::new(&mut s.timezone).range(-14.0..=14.0).speed(0.25).prefix("UTC "));
+        if s != site.0 {
+            site.0 = s;
+        }
+        sun_path(ui, &site.0, solar.0);
+    }
+    ui.separator();
+    sky_controls(ui, sky);
+    ui.separator();
+    let mut auto = settings.exposure.is_none();
+    let mut ev = settings.exposure.unwrap_or(10.0);
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut auto, "auto exposure");
+        ui.add_enabled(!auto, egui::Slider::new(&mut ev, -5.0..=20.0).text("EV"));
+    });
+    let exposure = if auto { None } else { Some(ev) };
+    if exposure != settings.exposure {
+        settings.exposure = exposure;
+    }
+    if let Some(note) = &state.note {
+        ui.colored_label(egui::Color32::from_rgb(230, 160, 60), note);
+    }
+}
+
+/// A map-free sun-path diagram: today's arc (altitude against azimuth, the
+/// horizon at the bottom) and the sun now.
+fn sun_path(ui: &mut Ui, site: &crate::site::Site, now: LocalDateTime) {
+    let (response, painter) = ui.allocate_painter(egui::vec2(ui.available_width().min(250.0), 110.0), egui::Sense::hover());
+    let rect = response.rect;
+    painter.rect_filled(rect, 4.0, egui::Color32::from_gray(28));
+    let to_screen = |azimuth: f64, altitude: f64| {
+        egui::pos2(rect.left() + (azimuth / 360.0) as f32 * rect.width(), rect.bottom() - (altitude.max(0.0) / 90.0) as f32 * rect.height())
+    };
+    for (label, azimuth) in [("E", 90.0), ("S", 180.0), ("W", 270.0)] {
+        painter.text(to_screen(azimuth, 0.0) + egui::vec2(0.0, -2.0), egui::Align2::CENTER_BOTTOM, label, egui::FontId::proportional(10.0), egui::Color32::GRAY);
+    }
+    let arc: Vec<egui::Pos2> = (0..=96)
+        .filter_map(|k| {
+            let time = TimeOfDay::from_hours(f64::from(k) / 4.0).ok()?;
+            let p = solar_position(site, &LocalDateTime { date: now.date, time });
+            (p.altitude > 0.0).then(|| to_screen(p.azimuth, p.altitude))
+        })
+        .collect();
+    painter.add(egui::Shape::line(arc, egui::Stroke::new(1.5, egui::Color32::from_rgb(200, 170, 60))));
+    let sun = solar_position(site, &now);
+    if sun.altitude > 0.0 {
+        painter.circle_filled(to_screen(sun.azimuth, sun.altitude), 5.0, egui::Color32::from_rgb(255, 210, 40));
+    }
+}
+
+/// The sky type and its parameters.
+fn sky_controls(ui: &mut Ui, sky: &mut ResMut<SkyChoice>) {
+    let names = ["clear", "turbid", "intermediate", "overcast", "uniform", "perez", "cie"];
+    let current = match &sky.0 {
+        SkySpec::Clear { turbidity } if *turbidity > 4.0 => "turbid",
+        SkySpec::Clear { .. } => "clear",
+        SkySpec::Intermediate { .. } => "intermediate",
+        SkySpec::Overcast => "overcast",
+        SkySpec::Uniform => "uniform",
+        SkySpec::Perez(_) => "perez",
+        SkySpec::Cie { .. } => "cie",
+    };
+    let mut chosen = current;
+    egui::ComboBox::from_label("sky").selected_text(current).show_ui(ui, |ui| {
+        for name in names {
+            ui.selectable_value(&mut chosen, name, name);
+        }
+    });
+    let mut spec = sky.0.clone();
+    if chosen != current {
+        spec = match chosen {
+            "clear" => SkySpec::Clear { turbidity: crate::sky::DEFAULT_TURBIDITY },
+            "turbid" => SkySpec::Clear { turbidity: 5.0 },
+            "intermediate" => SkySpec::Intermediate { turbidity: crate::sky::DEFAULT_TURBIDITY },
+            "overcast" => SkySpec::Overcast,
+            "uniform" => SkySpec::Uniform,
+            "perez" => SkySpec::Perez(perez::Input::Irradiance { direct_normal: 600.0, diffuse_horizontal: 120.0 }),
+            _ => SkySpec::Cie { standard_type: 12, diffuse_illuminance: 15_000.0, direct_illuminance: 60_000.0 },
+        };
+    }
+    match &mut spec {
+        SkySpec::Clear { turbidity } | SkySpec::Intermediate { turbidity } => {
+            ui.add(egui::Slider::new(turbidity, 1.0..=10.0).text("turbidity"));
+        }
+        SkySpec::Perez(perez::Input::Irradiance { direct_normal, diffuse_horizontal }) => {
+            ui.add(egui::DragValue::new(direct_normal).range(0.0..=1100.0).prefix("DNI ").suffix(" W/m²"));
+            ui.add(egui::DragValue::new(diffuse_horizontal).range(1.0..=600.0).prefix("DHI ").suffix(" W/m²"));
+        }
+        SkySpec::Cie { standard_type, diffuse_illuminance, direct_illuminance } => {
+            ui.add(egui::Slider::new(standard_type, 1..=15).text("CIE type"));
+            ui.add(egui::DragValue::new(diffuse_illuminance).range(100.0..=60_000.0).prefix("diffuse ").suffix(" lx"));
+            ui.add(egui::DragValue::new(direct_illuminance).range(0.0..=120_000.0).prefix("direct ").suffix(" lx"));
+        }
+        _ => {}
+    }
+    if spec != sky.0 {
+        sky.0 = spec;
+    }
+}
+
+fn view_panel(ui: &mut Ui, settings: &mut ResMut<RenderSettings>, lighting: Option<&LightingState>, engine: Option<&LightEngine>) {
+    ui.heading("View");
+    let labels = [(RenderMode::Full, "full"), (RenderMode::Sun, "direct sun"), (RenderMode::Sky, "direct sky"), (RenderMode::Indirect, "indirect"), (RenderMode::FalseColour, "false colour (lux)")];
+    let mut mode = settings.mode;
+    egui::ComboBox::from_label("mode").selected_text(labels.iter().find(|l| l.0 == mode).map_or("", |l| l.1)).show_ui(ui, |ui| {
+        for (value, label) in labels {
+            ui.selectable_value(&mut mode, value, label);
+        }
+    });
+    if mode != settings.mode {
+        settings.mode = mode;
+    }
+    if settings.mode == RenderMode::FalseColour {
+        let mut top = settings.false_colour_max_lux;
+        ui.add(egui::DragValue::new(&mut top).range(10.0..=200_000.0).prefix("scale top ").suffix(" lx"));
+        if top != settings.false_colour_max_lux {
+            settings.false_colour_max_lux = top;
+        }
+        false_colour_legend(ui, settings.false_colour_max_lux);
+    }
+    let progress = match (engine, lighting) {
+        (Some(e), _) if e.is_precomputing() => "precomputing the light…".to_string(),
+        (_, Some(l)) if l.lighting.is_some() => {
+            let iterations = l.lighting.as_ref().map_or(0, |x| x.iterations);
+            if l.converged { format!("light converged ({iterations} iterations)") } else { format!("light settling… iteration {iterations}") }
+        }
+        _ => "waiting for the light".to_string(),
+    };
+    ui.label(progress);
+    ui.separator();
+    ui.heading("Sensors (lux)");
+    let Some(readings) = lighting.and_then(|l| l.lighting.as_ref()).map(|l| &l.sensors) else { return };
+    egui::Grid::new("sensors").striped(true).num_columns(5).show(ui, |ui| {
+        for title in ["sensor", "total", "sun", "sky", "indirect"] {
+            ui.strong(title);
+        }
+        ui.end_row();
+        for r in readings {
+            ui.label(&r.name);
+            for value in [r.total, r.direct_sun, r.direct_sky, r.indirect] {
+                ui.monospace(format!("{value:8.0}"));
+            }
+            ui.end_row();
+        }
+    });
+}
+
+/// The false-colour scale as a bar with its decades.
+fn false_colour_legend(ui: &mut Ui, top: f32) {
+    let (response, painter) = ui.allocate_painter(egui::vec2(ui.available_width().min(260.0), 34.0), egui::Sense::hover());
+    let rect = response.rect;
+    let steps = 64;
+    for k in 0..steps {
+        let t = k as f32 / (steps - 1) as f32;
+        let lux = top * 1000f32.powf(t - 1.0);
+        let [r, g, b] = crate::render::false_colour(lux, top);
+        let colour = egui::Color32::from(egui::Rgba::from_rgb(r, g, b));
+        let x0 = rect.left() + rect.width() * k as f32 / steps as f32;
+        painter.rect_filled(egui::Rect::from_min_size(egui::pos2(x0, rect.top()), egui::vec2(rect.width() / steps as f32 + 1.0, 16.0)), 0.0, colour);
+    }
+    for decade in 0..4 {
+        let lux = top / 10f32.powi(3 - decade);
+        let x = rect.left() + rect.width() * decade as f32 / 3.0;
+        painter.text(egui::pos2(x, rect.bottom()), egui::Align2::CENTER_BOTTOM, format!("{lux:.0}"), egui::FontId::proportional(10.0), egui::Color32::LIGHT_GRAY);
+    }
+}
