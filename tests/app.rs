@@ -363,3 +363,19 @@ f 19 20 14 17
         assert!(result.agreement >= 0.99 && result.within >= 0.99, "{summary}");
     }
 }
+
+/// The viewer's day plot: a sensor's light over the day is dark at night,
+/// rises after sunrise and peaks around noon.
+#[test]
+fn the_day_series_of_a_sensor_follows_the_sun() {
+    use heliodon::viewer::sensors::{DAY_STEPS, day_series};
+    let scene = Arc::new(load_scene(&heliodon::bundled_scene("test_room"), &PanelCatalog::new()).unwrap().scene);
+    let settings = heliodon::light::LightSettings { rays_per_patch: 32, rays_per_sensor: 256, sun_samples_per_patch: 4, area_sensor_sun_grid: 4, ..Default::default() };
+    let model = Arc::new(LightModel::precompute(scene.clone(), settings).unwrap());
+    let centre = scene.sensors.iter().position(|s| s.name == "room-centre").unwrap();
+    let values = day_series(&model, centre, &scene.site, Date::new(2026, 3, 21).unwrap(), &SkySpec::Overcast);
+    assert_eq!(values.len(), DAY_STEPS);
+    let at = |hours: f64| values[(hours * DAY_STEPS as f64 / 24.0) as usize];
+    assert_eq!(at(2.0), 0.0, "night");
+    assert!(at(9.0) > 50.0 && at(12.0) > at(9.0) && at(12.0) > at(16.0), "{values:?}");
+}

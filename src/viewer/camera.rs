@@ -1,6 +1,7 @@
 //! A CAD-like camera: left-drag orbits about the focus, right- or middle-drag
 //! pans, the wheel zooms toward the point under the cursor, `F` frames the
-//! whole model. z is up.
+//! whole model. In walk mode (a panel checkbox) W/A/S/D move the eye at its
+//! height and left-drag looks around from it. z is up.
 
 use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll, MouseScrollUnit};
 use bevy::prelude::*;
@@ -28,6 +29,8 @@ const ORBIT_SPEED: f32 = 0.006;
 const ZOOM_STEP: f32 = 0.85;
 const PIXELS_PER_LINE: f32 = 40.0;
 const MAX_PITCH: f32 = 1.55;
+/// Walking speed, metres per second.
+const WALK_SPEED: f32 = 1.4;
 
 impl CadCamera {
     pub fn looking(eye: Vec3, target: Vec3) -> Self {
@@ -65,12 +68,14 @@ pub fn navigate(
     window: Single<&Window, With<PrimaryWindow>>,
     active: Res<ActiveScene>,
     ui: Option<Res<super::ui::UiState>>,
+    time: Res<Time>,
     mut cameras: Query<(&mut CadCamera, &mut Transform, &Camera, &GlobalTransform, &Projection)>,
 ) {
     // The pointer over a panel belongs to the panel.
-    if ui.is_some_and(|ui| ui.pointer_over_panels) {
+    if ui.as_ref().is_some_and(|ui| ui.pointer_over_panels) {
         return;
     }
+    let walking = ui.is_some_and(|ui| ui.walk);
     for (mut cad, mut transform, camera, global, projection) in &mut cameras {
         let fov = match projection {
             Projection::Perspective(p) => p.fov,
@@ -78,8 +83,26 @@ pub fn navigate(
         };
         let delta = motion.delta;
         if mouse.pressed(MouseButton::Left) && delta != Vec2::ZERO {
+            let eye = cad.eye();
             cad.yaw -= delta.x * ORBIT_SPEED;
             cad.pitch = (cad.pitch + delta.y * ORBIT_SPEED).clamp(-MAX_PITCH, MAX_PITCH);
+            if walking {
+                // Look around from the eye: the focus moves, the eye stays.
+                let look = cad.eye() - cad.focus;
+                cad.focus = eye - look;
+            }
+        }
+        if walking {
+            let (sin, cos) = cad.yaw.sin_cos();
+            let forward = -Vec3::new(cos, sin, 0.0);
+            let right = forward.cross(Vec3::Z);
+            let mut step = Vec3::ZERO;
+            for (key, direction) in [(KeyCode::KeyW, forward), (KeyCode::KeyS, -forward), (KeyCode::KeyD, right), (KeyCode::KeyA, -right)] {
+                if keys.pressed(key) {
+                    step += direction;
+                }
+            }
+            cad.focus += step.normalize_or_zero() * WALK_SPEED * time.delta_secs();
         }
         if (mouse.pressed(MouseButton::Right) || mouse.pressed(MouseButton::Middle)) && delta != Vec2::ZERO {
             // One pixel moves the focus by what a pixel spans at the focus distance.

@@ -1,7 +1,8 @@
 //! [`DesignerUiPlugin`]: the designer's panels (bevy_egui). Left: the sun
 //! and sky (date, time, play, site with a sun-path diagram, sky type and
-//! parameters, exposure). Right: the view (modes, the light's progress) and
-//! a live table of the sensors. The 3D view fills the space between them:
+//! parameters, exposure). Right: the camera (presets, viewpoints, walk
+//! mode), the view (modes, the light's progress, saving the image) and the
+//! sensors (live table, the selected one's day, CSV export). The 3D view fills the space between them:
 //! the camera's viewport follows the panels, and the pointer over a panel
 //! belongs to the panel.
 
@@ -13,7 +14,12 @@ use bevy::window::PrimaryWindow;
 use bevy_egui::egui::{self, LayerId, Ui, UiBuilder};
 use bevy_egui::{EguiContexts, EguiGlobalSettings, EguiPlugin, EguiPrimaryContextPass, PrimaryEguiContext};
 
-use crate::ecs::{LightEngine, LightingState, Site, SkyChoice, SolarTime, SunSky};
+use bevy::ecs::system::SystemParam;
+
+use super::camera::CadCamera;
+use super::sensors::{DAY_STEPS, DaySeries, SelectedSensor};
+use crate::ecs::{ActiveScene, LightEngine, LightingState, Site, SkyChoice, SolarTime, SunSky};
+use crate::scene::Viewpoint;
 use crate::render::sun_pass::SunPassView;
 use crate::render::{RenderMode, RenderSettings};
 use crate::sky::perez;
@@ -27,21 +33,50 @@ impl Plugin for DesignerUiPlugin {
     fn build(&self, app: &mut App) {
         app.add_plugins(EguiPlugin::default())
             .init_resource::<UiState>()
+            .init_resource::<SelectedSensor>()
+            .init_resource::<DaySeries>()
             .add_systems(Startup, spawn_ui_camera)
-            .add_systems(EguiPrimaryContextPass, panels)
-            .add_systems(Update, play_the_day);
+            .add_systems(EguiPrimaryContextPass, (panels, super::sensors::draw_markers).chain())
+            .add_systems(
+                Update,
+                (play_the_day, apply_camera_request, save_image, super::sensors::pick_sensor, super::sensors::update_day_series),
+            );
     }
 }
 
-/// What the panels keep between frames.
+/// What the panels keep between frames, and what they ask of the app.
 #[derive(Resource, Debug, Clone, Default)]
 pub struct UiState {
     /// The day plays: hours of solar time per second.
     pub playing: Option<f64>,
     /// Whether the pointer is over a panel (the camera then ignores it).
     pub pointer_over_panels: bool,
-    /// Last clamped input, shown under the panel until the next change.
+    /// Last clamped input or saved file, shown until the next one.
     pub note: Option<String>,
+    /// Views the user saved this session.
+    pub saved_views: Vec<Viewpoint>,
+    /// Walk mode: W/A/S/D move the eye at its height, dragging looks around.
+    pub walk: bool,
+    /// A camera change asked for by the panel, applied by [`apply_camera_request`].
+    pub camera_request: Option<CameraRequest>,
+    /// Save the window as a PNG (in the working folder).
+    pub save_image: bool,
+}
+
+/// The camera changes the panel offers.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CameraRequest {
+    /// Straight down on the model.
+    Top,
+    /// From the south, level.
+    Front,
+    /// From the east, level.
+    Side,
+    /// From the south-west and above.
+    Perspective,
+    Viewpoint(Viewpoint),
+    /// Keep the current view in the list.
+    Save,
 }
 
 /// The panels are drawn by a camera of their own over the whole window.
@@ -76,6 +111,16 @@ fn play_the_day(time: Res<Time>, ui: Res<UiState>, mut solar: ResMut<SolarTime>)
 /// The quick dates: equinoxes and solstices.
 const QUICK_DATES: [(&str, u32, u32); 4] = [("Mar 21", 3, 21), ("Jun 21", 6, 21), ("Sep 23", 9, 23), ("Dec 21", 12, 21)];
 
+/// What the sensors part of the panel reads and writes.
+#[derive(SystemParam)]
+pub struct SensorPanel<'w> {
+    lighting: Option<Res<'w, LightingState>>,
+    engine: Option<Res<'w, LightEngine>>,
+    selected: ResMut<'w, SelectedSensor>,
+    series: Res<'w, DaySeries>,
+    active: Res<'w, ActiveScene>,
+}
+
 #[allow(clippy::too_many_arguments)]
 fn panels(
     mut contexts: EguiContexts,
@@ -85,8 +130,7 @@ fn panels(
     mut settings: ResMut<RenderSettings>,
     site: Option<ResMut<Site>>,
     sun_sky: Option<Res<SunSky>>,
-    lighting: Option<Res<LightingState>>,
-    engine: Option<Res<LightEngine>>,
+    mut sensors: SensorPanel,
     window: Single<&Window, With<PrimaryWindow>>,
     mut cameras: Query<&mut Camera, With<SunPassView>>,
 ) -> Result {
@@ -106,7 +150,11 @@ fn panels(
         .default_size(330.0)
         .show(&mut root, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
-                view_panel(ui, &mut settings, lighting.as_deref(), engine.as_deref());
+                camera_panel(ui, &mut ui_state, &sensors.active);
+                ui.separator();
+                view_panel(ui, &mut ui_state, &mut settings, sensors.lighting.as_deref(), sensors.engine.as_deref());
+                ui.separator();
+                sensor_panel(ui, &mut ui_state, &mut sensors, &solar);
             });
         })
         .response
@@ -306,7 +354,7 @@ fn sky_controls(ui: &mut Ui, sky: &mut ResMut<SkyChoice>) {
     }
 }
 
-fn view_panel(ui: &mut Ui, settings: &mut ResMut<RenderSettings>, lighting: Option<&LightingState>, engine: Option<&LightEngine>) {
+fn view_panel(ui: &mut Ui, state: &mut UiState, settings: &mut ResMut<RenderSettings>, lighting: Option<&LightingState>, engine: Option<&LightEngine>) {
     ui.heading("View");
     let labels = [(RenderMode::Full, "full"), (RenderMode::Sun, "direct sun"), (RenderMode::Sky, "direct sky"), (RenderMode::Indirect, "indirect"), (RenderMode::FalseColour, "false colour (lux)")];
     let mut mode = settings.mode;
@@ -335,22 +383,149 @@ fn view_panel(ui: &mut Ui, settings: &mut ResMut<RenderSettings>, lighting: Opti
         _ => "waiting for the light".to_string(),
     };
     ui.label(progress);
-    ui.separator();
+    if ui.button("Save image (PNG)").clicked() {
+        state.save_image = true;
+    }
+}
+
+/// Camera presets, the scene's and the user's viewpoints, walk mode.
+fn camera_panel(ui: &mut Ui, state: &mut UiState, active: &ActiveScene) {
+    ui.heading("Camera");
+    ui.horizontal(|ui| {
+        for (label, request) in [("Top", CameraRequest::Top), ("Front", CameraRequest::Front), ("Side", CameraRequest::Side), ("3D", CameraRequest::Perspective)] {
+            if ui.button(label).clicked() {
+                state.camera_request = Some(request);
+            }
+        }
+    });
+    let views: Vec<Viewpoint> = active.scene.iter().flat_map(|s| s.viewpoints.iter().cloned()).chain(state.saved_views.iter().cloned()).collect();
+    ui.horizontal(|ui| {
+        egui::ComboBox::from_id_salt("viewpoints").selected_text("viewpoints").show_ui(ui, |ui| {
+            for view in &views {
+                if ui.selectable_label(false, &view.name).clicked() {
+                    state.camera_request = Some(CameraRequest::Viewpoint(view.clone()));
+                }
+            }
+        });
+        if ui.button("Save view").clicked() {
+            state.camera_request = Some(CameraRequest::Save);
+        }
+    });
+    ui.checkbox(&mut state.walk, "walk (W A S D)");
+}
+
+/// The live sensor table, the selected sensor's day, CSV export.
+fn sensor_panel(ui: &mut Ui, state: &mut UiState, sensors: &mut SensorPanel, solar: &SolarTime) {
     ui.heading("Sensors (lux)");
-    let Some(readings) = lighting.and_then(|l| l.lighting.as_ref()).map(|l| &l.sensors) else { return };
+    let Some(lighting) = sensors.lighting.as_ref().and_then(|l| l.lighting.as_ref()) else { return };
+    let readings = &lighting.sensors;
+    if let Some(selected) = sensors.selected.0.and_then(|i| readings.get(i)) {
+        ui.label(format!("{}: {:.0} lx over {} (every half hour)", selected.name, selected.total, solar.0.date));
+        match &sensors.series.values {
+            Some(values) => day_plot(ui, values, solar.0.time.hours()),
+            None => {
+                ui.add(egui::Spinner::new());
+            }
+        }
+    } else {
+        ui.label("Click a sensor (in the view or the table) for its day.");
+    }
+    ui.horizontal(|ui| {
+        if ui.button("Export table (CSV)").clicked() {
+            let mut csv = String::from("name,illuminance_lux,direct_sun_lux,direct_sky_lux,indirect_lux\n");
+            for r in readings {
+                csv.push_str(&format!("{},{:.1},{:.1},{:.1},{:.1}\n", r.name, r.total, r.direct_sun, r.direct_sky, r.indirect));
+            }
+            state.note = Some(write_export("heliodon-sensors.csv", &csv));
+        }
+        if let (Some(values), Some(i)) = (&sensors.series.values, sensors.selected.0)
+            && ui.button("Export day (CSV)").clicked()
+        {
+            let mut csv = String::from("time,illuminance_lux\n");
+            for (k, v) in values.iter().enumerate() {
+                let minutes = ((k as f64 + 0.5) * 24.0 * 60.0 / DAY_STEPS as f64).round() as i64;
+                csv.push_str(&format!("{:02}:{:02},{v:.1}\n", minutes / 60, minutes % 60));
+            }
+            state.note = Some(write_export(&format!("heliodon-day-{}.csv", readings[i].name.replace('/', "-")), &csv));
+        }
+    });
     egui::Grid::new("sensors").striped(true).num_columns(5).show(ui, |ui| {
         for title in ["sensor", "total", "sun", "sky", "indirect"] {
             ui.strong(title);
         }
         ui.end_row();
-        for r in readings {
-            ui.label(&r.name);
+        for (i, r) in readings.iter().enumerate() {
+            if ui.selectable_label(sensors.selected.0 == Some(i), &r.name).clicked() {
+                sensors.selected.0 = Some(i);
+            }
             for value in [r.total, r.direct_sun, r.direct_sky, r.indirect] {
                 ui.monospace(format!("{value:8.0}"));
             }
             ui.end_row();
         }
     });
+}
+
+/// Writes an export into the working folder; what to tell the user.
+fn write_export(name: &str, text: &str) -> String {
+    match std::fs::write(name, text) {
+        Ok(()) => format!("wrote {}", std::env::current_dir().map(|d| d.join(name).display().to_string()).unwrap_or(name.into())),
+        Err(e) => format!("cannot write {name}: {e}"),
+    }
+}
+
+/// Illuminance over the day (log scale, 10 lx to the day's peak), with the
+/// current time marked.
+fn day_plot(ui: &mut Ui, values: &[f64], now: f64) {
+    let (response, painter) = ui.allocate_painter(egui::vec2(ui.available_width().min(300.0), 120.0), egui::Sense::hover());
+    let rect = response.rect;
+    painter.rect_filled(rect, 4.0, egui::Color32::from_gray(28));
+    let peak = values.iter().copied().fold(10.0f64, f64::max);
+    let y = |lux: f64| rect.bottom() - ((lux.max(10.0) / 10.0).log10() / (peak / 10.0).log10().max(1e-6)) as f32 * (rect.height() - 14.0);
+    let x = |hours: f64| rect.left() + (hours / 24.0) as f32 * rect.width();
+    let points: Vec<egui::Pos2> = values.iter().enumerate().map(|(k, &v)| egui::pos2(x((k as f64 + 0.5) * 24.0 / values.len() as f64), y(v))).collect();
+    painter.add(egui::Shape::line(points, egui::Stroke::new(1.5, egui::Color32::from_rgb(120, 200, 255))));
+    painter.line_segment([egui::pos2(x(now), rect.top()), egui::pos2(x(now), rect.bottom())], egui::Stroke::new(1.0, egui::Color32::from_rgb(255, 210, 40)));
+    painter.text(rect.left_top() + egui::vec2(4.0, 2.0), egui::Align2::LEFT_TOP, format!("{peak:.0} lx"), egui::FontId::proportional(10.0), egui::Color32::LIGHT_GRAY);
+    for hours in [6.0, 12.0, 18.0] {
+        painter.text(egui::pos2(x(hours), rect.bottom()), egui::Align2::CENTER_BOTTOM, format!("{hours:.0}h"), egui::FontId::proportional(10.0), egui::Color32::GRAY);
+    }
+}
+
+/// Applies the camera panel's request.
+pub fn apply_camera_request(mut state: ResMut<UiState>, active: Res<ActiveScene>, mut cameras: Query<&mut CadCamera>) {
+    let Some(request) = state.camera_request.take() else { return };
+    let Some(scene) = &active.scene else { return };
+    let (centre, distance) = crate::render::framing(scene.bounds, crate::scene::DEFAULT_FOV);
+    for mut camera in &mut cameras {
+        let (yaw, pitch) = match &request {
+            CameraRequest::Top => (-std::f32::consts::FRAC_PI_2, 1.5),
+            CameraRequest::Front => (-std::f32::consts::FRAC_PI_2, 0.0),
+            CameraRequest::Side => (0.0, 0.0),
+            CameraRequest::Perspective => (-2.2, 0.6),
+            CameraRequest::Viewpoint(view) => {
+                *camera = CadCamera::from_viewpoint(view);
+                continue;
+            }
+            CameraRequest::Save => {
+                let name = format!("saved {}", state.saved_views.len() + 1);
+                let eye = camera.eye();
+                state.saved_views.push(Viewpoint { name, eye, target: camera.focus, fov: crate::scene::DEFAULT_FOV });
+                continue;
+            }
+        };
+        *camera = CadCamera { focus: centre, distance, yaw, pitch };
+    }
+}
+
+/// Saves the window when asked.
+fn save_image(mut state: ResMut<UiState>, mut commands: Commands) {
+    if !std::mem::take(&mut state.save_image) {
+        return;
+    }
+    let name = format!("heliodon-view-{}.png", std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs()));
+    state.note = Some(format!("saving {name}"));
+    commands.spawn(bevy::render::view::screenshot::Screenshot::primary_window()).observe(bevy::render::view::screenshot::save_to_disk(name));
 }
 
 /// The false-colour scale as a bar with its decades.

@@ -1,0 +1,156 @@
+//! Sensors in the viewer: markers with their readings in the 3D view, a
+//! selected sensor (click a marker or a table row), and the selected
+//! sensor's illuminance over the current day, computed in the background
+//! with the light engine (every half hour, each solve warm-started from the
+//! previous one).
+
+use std::sync::Arc;
+
+use bevy::prelude::*;
+use bevy::tasks::{AsyncComputeTaskPool, Task, block_on, futures_lite::future};
+
+use crate::ecs::{LightEngine, LightingState, Site, SkyChoice, SolarTime};
+use crate::light::LightModel;
+use crate::render::sun_pass::SunPassView;
+use crate::sky::{Sky, SkySpec};
+use crate::sun::solar_position;
+use crate::time::{Date, LocalDateTime, TimeOfDay};
+
+/// The sensor the panels and the plot follow.
+#[derive(Resource, Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct SelectedSensor(pub Option<usize>);
+
+/// Half-hour steps of the day plot.
+pub const DAY_STEPS: usize = 48;
+
+/// The selected sensor's total illuminance (lux) over the day, by half
+/// hour from 00:15; `None` while it is being computed.
+#[derive(Resource, Default)]
+pub struct DaySeries {
+    /// For which sensor, date, sky and site (a new one restarts it).
+    key: Option<(usize, Date, String)>,
+    task: Option<Task<Vec<f64>>>,
+    pub values: Option<Vec<f64>>,
+}
+
+impl DaySeries {
+    pub fn computing(&self) -> bool {
+        self.task.is_some()
+    }
+}
+
+/// Sensor markers: a small cross and, over it, its total lux.
+pub fn draw_markers(
+    mut gizmos: Gizmos,
+    active: Res<crate::ecs::ActiveScene>,
+    selected: Res<SelectedSensor>,
+    mut contexts: bevy_egui::EguiContexts,
+    lighting: Option<Res<LightingState>>,
+    camera: Query<(&Camera, &GlobalTransform), With<SunPassView>>,
+) -> Result {
+    let Some(scene) = &active.scene else { return Ok(()) };
+    let Ok((camera, transform)) = camera.single() else { return Ok(()) };
+    let ctx = contexts.ctx_mut()?.clone();
+    let readings = lighting.as_ref().and_then(|l| l.lighting.as_ref()).map(|l| &l.sensors);
+    for (i, sensor) in scene.sensors.iter().enumerate() {
+        let chosen = selected.0 == Some(i);
+        let colour = if chosen { Color::srgb(1.0, 0.3, 0.2) } else { Color::srgb(0.2, 0.8, 1.0) };
+        let size = if chosen { 0.12 } else { 0.06 };
+        let p = sensor.position;
+        gizmos.line(p - Vec3::X * size, p + Vec3::X * size, colour);
+        gizmos.line(p - Vec3::Y * size, p + Vec3::Y * size, colour);
+        gizmos.line(p, p + sensor.normal * size * 2.0, colour);
+        let (Some(reading), Ok(screen)) = (readings.and_then(|r| r.get(i)), camera.world_to_viewport(transform, p)) else { continue };
+        // Labels for the chosen sensor and, to keep the view readable, for a few.
+        if chosen || scene.sensors.len() <= 12 {
+            let scale = ctx.pixels_per_point();
+            let offset = camera.viewport.as_ref().map_or(Vec2::ZERO, |v| v.physical_position.as_vec2() / scale);
+            bevy_egui::egui::Area::new(bevy_egui::egui::Id::new(("sensor", i)))
+                .fixed_pos(bevy_egui::egui::pos2(screen.x + offset.x + 6.0, screen.y + offset.y - 18.0))
+                .interactable(false)
+                .show(&ctx, |ui| {
+                    ui.label(bevy_egui::egui::RichText::new(format!("{} {:.0} lx", sensor.name, reading.total)).small().background_color(bevy_egui::egui::Color32::from_black_alpha(160)));
+                });
+        }
+    }
+    Ok(())
+}
+
+/// A click (without dragging) near a marker selects it.
+pub fn pick_sensor(
+    mouse: Res<ButtonInput<MouseButton>>,
+    window: Single<&Window, bevy::ecs::query::With<bevy::window::PrimaryWindow>>,
+    active: Res<crate::ecs::ActiveScene>,
+    ui: Res<super::ui::UiState>,
+    camera: Query<(&Camera, &GlobalTransform), With<SunPassView>>,
+    mut pressed_at: Local<Option<Vec2>>,
+    mut selected: ResMut<SelectedSensor>,
+) {
+    let Some(cursor) = window.cursor_position() else { return };
+    if mouse.just_pressed(MouseButton::Left) {
+        *pressed_at = Some(cursor);
+    }
+    if !mouse.just_released(MouseButton::Left) || ui.pointer_over_panels {
+        return;
+    }
+    let Some(start) = pressed_at.take() else { return };
+    if start.distance(cursor) > 4.0 {
+        return;
+    }
+    let (Some(scene), Ok((camera, transform))) = (&active.scene, camera.single()) else { return };
+    let offset = camera.viewport.as_ref().map_or(Vec2::ZERO, |v| v.physical_position.as_vec2() / window.scale_factor());
+    let nearest = scene
+        .sensors
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| camera.world_to_viewport(transform, s.position).ok().map(|p| (i, (p + offset).distance(cursor))))
+        .filter(|(_, d)| *d < 14.0)
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    if let Some((i, _)) = nearest {
+        selected.0 = Some(i);
+    }
+}
+
+/// Starts the selected sensor's day series when the sensor, date, sky or
+/// site change, and collects it when done.
+#[allow(clippy::too_many_arguments)]
+pub fn update_day_series(
+    selected: Res<SelectedSensor>,
+    solar: Res<SolarTime>,
+    sky: Res<SkyChoice>,
+    site: Option<Res<Site>>,
+    engine: Option<Res<LightEngine>>,
+    mut series: ResMut<DaySeries>,
+) {
+    if let Some(task) = &mut series.task
+        && let Some(values) = block_on(future::poll_once(task))
+    {
+        series.values = Some(values);
+        series.task = None;
+    }
+    let (Some(sensor), Some(site), Some(model)) = (selected.0, site, engine.and_then(|e| e.model.clone())) else { return };
+    let key = (sensor, solar.0.date, format!("{:?} {:?}", sky.0, site.0));
+    if series.key.as_ref() == Some(&key) {
+        return;
+    }
+    let (date, spec, site) = (solar.0.date, sky.0.clone(), site.0);
+    series.key = Some(key);
+    series.values = None;
+    series.task = Some(AsyncComputeTaskPool::get().spawn(async move { day_series(&model, sensor, &site, date, &spec) }));
+}
+
+/// A sensor's total lux every half hour of a day.
+pub fn day_series(model: &Arc<LightModel>, sensor: usize, site: &crate::site::Site, date: Date, spec: &SkySpec) -> Vec<f64> {
+    let mut previous = None;
+    (0..DAY_STEPS)
+        .map(|k| {
+            let time = TimeOfDay::from_hours((k as f64 + 0.5) * 24.0 / DAY_STEPS as f64).expect("a time of day");
+            let position = solar_position(site, &LocalDateTime { date, time });
+            let Ok(sky) = Sky::new(spec, position.altitude, position.azimuth, site.ground_reflectance, date.day_of_year()) else { return 0.0 };
+            let lighting = model.solve(&sky, previous.as_ref());
+            let value = lighting.sensors.get(sensor).map_or(0.0, |r| r.total);
+            previous = Some(lighting);
+            value
+        })
+        .collect()
+}
