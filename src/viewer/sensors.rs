@@ -5,6 +5,7 @@
 //! previous one).
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task, block_on, futures_lite::future};
@@ -37,6 +38,73 @@ impl DaySeries {
     pub fn computing(&self) -> bool {
         self.task.is_some()
     }
+}
+
+/// Days of the year map: every two weeks from 1 January.
+pub const YEAR_DAYS: usize = 26;
+
+/// The selected sensor's illuminance over the year: day × half hour (the
+/// thesis' figure 1.4h), computed in the background when asked for.
+#[derive(Resource, Default)]
+pub struct YearMap {
+    /// Sensor, year and sky it was asked for.
+    key: Option<(usize, i32, String)>,
+    task: Option<Task<Vec<Vec<f64>>>>,
+    /// Days done, for the progress bar.
+    done: Arc<AtomicUsize>,
+    pub values: Option<Vec<Vec<f64>>>,
+    /// Set by the panel's button.
+    pub requested: bool,
+}
+
+impl YearMap {
+    /// Share done while computing.
+    pub fn progress(&self) -> Option<f32> {
+        self.task.as_ref().map(|_| self.done.load(Ordering::Relaxed) as f32 / YEAR_DAYS as f32)
+    }
+}
+
+/// Starts the year map when asked (for the selected sensor, the current
+/// year and sky), and collects it.
+pub fn update_year_map(
+    selected: Res<SelectedSensor>,
+    solar: Res<SolarTime>,
+    sky: Res<SkyChoice>,
+    site: Option<Res<Site>>,
+    engine: Option<Res<LightEngine>>,
+    mut map: ResMut<YearMap>,
+) {
+    if let Some(task) = &mut map.task
+        && let Some(values) = block_on(future::poll_once(task))
+    {
+        map.values = Some(values);
+        map.task = None;
+    }
+    let key = selected.0.map(|s| (s, solar.0.date.year, format!("{:?}", sky.0)));
+    if map.key.is_some() && map.key != key && map.task.is_none() {
+        // What is shown no longer fits the sensor or sky.
+        map.values = None;
+        map.key = None;
+    }
+    if !std::mem::take(&mut map.requested) {
+        return;
+    }
+    let (Some(sensor), Some(site), Some(model)) = (selected.0, site, engine.and_then(|e| e.model.clone())) else { return };
+    let (year, spec, site) = (solar.0.date.year, sky.0.clone(), site.0);
+    let done = Arc::new(AtomicUsize::new(0));
+    map.done = done.clone();
+    map.key = key;
+    map.values = None;
+    map.task = Some(AsyncComputeTaskPool::get().spawn(async move {
+        (0..YEAR_DAYS)
+            .map(|k| {
+                let date = Date::new(year, 1, 1).expect("1 January").add_days(14 * k as i64);
+                let day = day_series(&model, sensor, &site, date, &spec);
+                done.fetch_add(1, Ordering::Relaxed);
+                day
+            })
+            .collect()
+    }));
 }
 
 /// Sensor markers: a small cross and, over it, its total lux.

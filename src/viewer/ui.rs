@@ -17,7 +17,7 @@ use bevy_egui::{EguiContexts, EguiGlobalSettings, EguiPlugin, EguiPrimaryContext
 use bevy::ecs::system::SystemParam;
 
 use super::camera::CadCamera;
-use super::sensors::{DAY_STEPS, DaySeries, SelectedSensor};
+use super::sensors::{DAY_STEPS, DaySeries, SelectedSensor, YEAR_DAYS, YearMap};
 use crate::ecs::{ActiveScene, LightEngine, LightingState, Site, SkyChoice, SolarTime, SunSky};
 use crate::scene::Viewpoint;
 use crate::render::sun_pass::SunPassView;
@@ -35,11 +35,19 @@ impl Plugin for DesignerUiPlugin {
             .init_resource::<UiState>()
             .init_resource::<SelectedSensor>()
             .init_resource::<DaySeries>()
+            .init_resource::<YearMap>()
             .add_systems(Startup, spawn_ui_camera)
             .add_systems(EguiPrimaryContextPass, (panels, super::sensors::draw_markers).chain())
             .add_systems(
                 Update,
-                (play_the_day, apply_camera_request, save_image, super::sensors::pick_sensor, super::sensors::update_day_series),
+                (
+                    play_the_day,
+                    apply_camera_request,
+                    save_image,
+                    super::sensors::pick_sensor,
+                    super::sensors::update_day_series,
+                    super::sensors::update_year_map,
+                ),
             );
     }
 }
@@ -118,6 +126,7 @@ pub struct SensorPanel<'w> {
     engine: Option<Res<'w, LightEngine>>,
     selected: ResMut<'w, SelectedSensor>,
     series: Res<'w, DaySeries>,
+    year: ResMut<'w, YearMap>,
     active: Res<'w, ActiveScene>,
 }
 
@@ -427,6 +436,17 @@ fn sensor_panel(ui: &mut Ui, state: &mut UiState, sensors: &mut SensorPanel, sol
                 ui.add(egui::Spinner::new());
             }
         }
+        match (&sensors.year.values, sensors.year.progress()) {
+            (_, Some(done)) => {
+                ui.add(egui::ProgressBar::new(done).text("the year, every two weeks…"));
+            }
+            (Some(values), None) => year_map(ui, values, solar.0.date.day_of_year(), solar.0.time.hours()),
+            (None, None) => {
+                if ui.button("Compute the year (day × time)").clicked() {
+                    sensors.year.requested = true;
+                }
+            }
+        }
     } else {
         ui.label("Click a sensor (in the view or the table) for its day.");
     }
@@ -464,6 +484,25 @@ fn sensor_panel(ui: &mut Ui, state: &mut UiState, sensors: &mut SensorPanel, sol
             ui.end_row();
         }
     });
+}
+
+/// The year as a heat map: days of the year across, time of day up, each
+/// cell in false colour (top of the scale: the year's peak), now marked.
+fn year_map(ui: &mut Ui, values: &[Vec<f64>], day: u32, now: f64) {
+    let (response, painter) = ui.allocate_painter(egui::vec2(ui.available_width().min(300.0), 130.0), egui::Sense::hover());
+    let rect = response.rect;
+    let peak = values.iter().flatten().copied().fold(10.0f64, f64::max) as f32;
+    let (w, h) = (rect.width() / YEAR_DAYS as f32, rect.height() / DAY_STEPS as f32);
+    for (d, day_values) in values.iter().enumerate() {
+        for (t, &lux) in day_values.iter().enumerate() {
+            let [r, g, b] = if lux > 0.0 { crate::render::false_colour(lux as f32, peak) } else { [0.05; 3] };
+            let cell = egui::Rect::from_min_size(egui::pos2(rect.left() + d as f32 * w, rect.bottom() - (t + 1) as f32 * h), egui::vec2(w + 0.5, h + 0.5));
+            painter.rect_filled(cell, 0.0, egui::Color32::from(egui::Rgba::from_rgb(r, g, b)));
+        }
+    }
+    let now_point = egui::pos2(rect.left() + (day as f32 / 366.0) * rect.width(), rect.bottom() - (now / 24.0) as f32 * rect.height());
+    painter.circle_stroke(now_point, 4.0, egui::Stroke::new(1.5, egui::Color32::WHITE));
+    painter.text(rect.left_top() + egui::vec2(4.0, 2.0), egui::Align2::LEFT_TOP, format!("peak {peak:.0} lx"), egui::FontId::proportional(10.0), egui::Color32::WHITE);
 }
 
 /// Writes an export into the working folder; what to tell the user.
