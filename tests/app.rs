@@ -379,3 +379,47 @@ fn the_day_series_of_a_sensor_follows_the_sun() {
     assert_eq!(at(2.0), 0.0, "night");
     assert!(at(9.0) > 50.0 && at(12.0) > at(9.0) && at(12.0) > at(16.0), "{values:?}");
 }
+
+/// Editing materials as the materials panel does: the scene is spawned
+/// again and relit. Darker glass lets less light in; a wall cannot become
+/// a window (the edit is refused with a message).
+#[test]
+fn material_edits_relight_and_impossible_ones_are_refused() {
+    use heliodon::ecs::{ActiveScene, EditMaterial, LightCacheDir, LightEngine, LightingSettings, LightingState, MaterialEditRejected};
+    use heliodon::light::LightSettings;
+    use heliodon::scene::MaterialKind;
+
+    let mut app = headless_app();
+    let settings = LightSettings { rays_per_patch: 64, rays_per_sensor: 512, sun_samples_per_patch: 4, area_sensor_sun_grid: 4, ..Default::default() };
+    app.insert_resource(LightingSettings(settings)).insert_resource(LightCacheDir(None));
+    open(&mut app, heliodon::bundled_scene("test_room")).unwrap();
+    let settle = |app: &mut App| -> f64 {
+        let deadline = Instant::now() + Duration::from_secs(120);
+        loop {
+            app.update();
+            let engine = app.world().resource::<LightEngine>();
+            let state = app.world().resource::<LightingState>();
+            if engine.model.is_some() && state.converged && state.generation == engine.generation() {
+                return state.lighting.as_ref().unwrap().sensors.iter().map(|s| s.total).sum();
+            }
+            assert!(Instant::now() < deadline, "lighting did not settle");
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    };
+    let before = settle(&mut app);
+    let materials = app.world().resource::<ActiveScene>().scene.clone().unwrap().materials.clone();
+    let glass = materials.iter().position(|m| matches!(m.kind, MaterialKind::Glass { .. })).unwrap() as u32;
+    let wall = materials.iter().position(|m| m.name == "wall").unwrap() as u32;
+    app.world_mut().write_message(EditMaterial { index: glass, kind: MaterialKind::Glass { transmittance: 0.44 } });
+    app.world_mut().write_message(EditMaterial { index: wall, kind: MaterialKind::Glass { transmittance: 0.5 } });
+    app.update();
+    let refused: Vec<String> = app.world_mut().resource_mut::<Messages<MaterialEditRejected>>().drain().map(|m| m.message).collect();
+    assert_eq!(refused.len(), 1, "{refused:?}");
+    assert!(refused[0].contains("'wall' is a diffuse"), "{}", refused[0]);
+    let after = settle(&mut app);
+    let scene = app.world().resource::<ActiveScene>().scene.clone().unwrap();
+    assert_eq!(scene.materials[glass as usize].kind, MaterialKind::Glass { transmittance: 0.44 });
+    assert!(matches!(scene.materials[wall as usize].kind, MaterialKind::Diffuse { .. }));
+    // Half the glass transmittance at normal incidence: about half the daylight.
+    assert!(after < 0.6 * before && after > 0.4 * before, "{before} -> {after}");
+}

@@ -24,6 +24,8 @@ impl Plugin for ScenePlugin {
             .add_message::<OpenScene>()
             .add_message::<SceneSpawned>()
             .add_message::<SceneLoadFailed>()
+            .add_message::<EditMaterial>()
+            .add_message::<MaterialEditRejected>()
             .configure_sets(
                 Update,
                 (
@@ -35,7 +37,7 @@ impl Plugin for ScenePlugin {
                     .chain(),
             )
             .add_systems(Update, request_scene.in_set(HeliodonSystems::LoadScene))
-            .add_systems(Update, (spawn_loaded_scene, report_failed_load).in_set(HeliodonSystems::SpawnScene));
+            .add_systems(Update, (spawn_loaded_scene, report_failed_load, apply_material_edits).in_set(HeliodonSystems::SpawnScene));
     }
 }
 
@@ -47,6 +49,24 @@ pub struct OpenScene(pub PathBuf);
 #[derive(Message, Debug, Clone)]
 pub struct SceneSpawned {
     pub root: Entity,
+    /// The same scene again with edited materials (a view need not reset).
+    pub edited: bool,
+}
+
+/// Change a material of the active scene: a diffuse one's reflectance, or a
+/// window material between glass and a registered panel. The scene is
+/// spawned again and its light recomputed.
+#[derive(Message, Debug, Clone)]
+pub struct EditMaterial {
+    pub index: u32,
+    pub kind: scene::MaterialKind,
+}
+
+/// An edit that cannot apply (a diffuse material made a window, or the
+/// reverse); one line.
+#[derive(Message, Debug, Clone, PartialEq, Eq)]
+pub struct MaterialEditRejected {
+    pub message: String,
 }
 
 /// A requested scene could not be loaded; `message` is one line.
@@ -150,7 +170,41 @@ fn spawn_loaded_scene(
     active.scene = Some(scene);
     active.root = Some(root);
     active.pending = None;
-    spawned.write(SceneSpawned { root });
+    spawned.write(SceneSpawned { root, edited: false });
+}
+
+/// Applies material edits: the scene with the new materials replaces the
+/// active one (same geometry, surfaces and windows).
+fn apply_material_edits(
+    mut commands: Commands,
+    mut edits: MessageReader<EditMaterial>,
+    mut active: ResMut<ActiveScene>,
+    mut spawned: MessageWriter<SceneSpawned>,
+    mut rejected: MessageWriter<MaterialEditRejected>,
+) {
+    let edits: Vec<EditMaterial> = edits.read().cloned().collect();
+    if edits.is_empty() {
+        return;
+    }
+    let Some(current) = active.scene.clone() else { return };
+    let mut scene = (*current).clone();
+    for edit in edits {
+        let Some(material) = scene.materials.get_mut(edit.index as usize) else { continue };
+        if material.kind.transmits() != edit.kind.transmits() {
+            rejected.write(MaterialEditRejected {
+                message: format!("material '{}' is a {}; it cannot become a {}", material.name, material.kind.label(), edit.kind.label()),
+            });
+            continue;
+        }
+        material.kind = edit.kind;
+    }
+    if let Some(old) = active.root.take() {
+        commands.entity(old).despawn();
+    }
+    let root = spawn_scene(&mut commands, &scene);
+    active.scene = Some(Arc::new(scene));
+    active.root = Some(root);
+    spawned.write(SceneSpawned { root, edited: true });
 }
 
 fn report_failed_load(

@@ -11,11 +11,11 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use super::{Gather, LightModel, LightSettings, SensorGeometry};
-use crate::scene::Scene;
+use crate::scene::{MaterialKind, Scene};
 
 const MAGIC: &[u8; 8] = b"HELIOLT\0";
 /// Bump when the model or its layout changes.
-const FORMAT: u32 = 3;
+const FORMAT: u32 = 4;
 
 /// What happened to the cache.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -70,6 +70,15 @@ pub fn key(scene: &Scene, settings: &LightSettings) -> std::io::Result<u64> {
     for path in std::iter::once(&scene.files.scene).chain(std::iter::once(&scene.files.obj)).chain(&scene.files.mtls) {
         let data = fs::read(path)?;
         hash.u64(data.len() as u64).bytes(&data);
+    }
+    // Materials edited at run time: what the gathers depend on (which
+    // materials pass light, and glass transmittance; not reflectances).
+    for material in &scene.materials {
+        match &material.kind {
+            MaterialKind::Diffuse { .. } => hash.u64(0),
+            MaterialKind::Glass { transmittance } => hash.u64(1).u64(u64::from(transmittance.to_bits())),
+            MaterialKind::Panel { .. } => hash.u64(2),
+        };
     }
     hash.u64(settings.rays_per_patch as u64)
         .u64(settings.rays_per_sensor as u64)

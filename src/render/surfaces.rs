@@ -128,7 +128,7 @@ fn spawn_surface_meshes(
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<LightingMaterial>>,
 ) {
-    let Some(SceneSpawned { root }) = spawned.read().last() else { return };
+    let Some(SceneSpawned { root, .. }) = spawned.read().last() else { return };
     let Some(scene) = &active.scene else { return };
     for (index, material) in scene.materials.iter().enumerate() {
         let Some((mesh, values)) = material_mesh(scene, index as u32) else { continue };

@@ -84,7 +84,8 @@ fn frame_new_scene(
     active: Res<ActiveScene>,
     mut cameras: Query<(&mut CadCamera, &mut Projection)>,
 ) {
-    if spawned.read().last().is_none() {
+    // A new scene opens on its first view; the same one with edited materials keeps the camera.
+    if spawned.read().last().is_none_or(|s| s.edited) {
         return;
     }
     let Some(scene) = &active.scene else { return };

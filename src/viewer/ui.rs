@@ -18,7 +18,9 @@ use bevy::ecs::system::SystemParam;
 
 use super::camera::CadCamera;
 use super::sensors::{DAY_STEPS, DaySeries, SelectedSensor, YEAR_DAYS, YearMap};
-use crate::ecs::{ActiveScene, LightEngine, LightingState, Site, SkyChoice, SolarTime, SunSky};
+use crate::ecs::{ActiveScene, EditMaterial, LightEngine, LightingState, MaterialEditRejected, PanelRegistry, Site, SkyChoice, SolarTime, SunSky};
+use crate::panel::Parameters;
+use crate::scene::{MaterialKind, Rgb};
 use crate::scene::Viewpoint;
 use crate::render::sun_pass::SunPassView;
 use crate::render::{RenderMode, RenderSettings};
@@ -69,6 +71,8 @@ pub struct UiState {
     pub camera_request: Option<CameraRequest>,
     /// Save the window as a PNG (in the working folder).
     pub save_image: bool,
+    /// Panel materials' keys being edited (TOML), by material index.
+    pub panel_text: std::collections::HashMap<u32, String>,
 }
 
 /// The camera changes the panel offers.
@@ -130,6 +134,14 @@ pub struct SensorPanel<'w> {
     active: Res<'w, ActiveScene>,
 }
 
+/// What the materials part of the panel needs.
+#[derive(SystemParam)]
+pub struct MaterialPanel<'w, 's> {
+    registry: Option<Res<'w, PanelRegistry>>,
+    edits: MessageWriter<'w, EditMaterial>,
+    rejected: MessageReader<'w, 's, MaterialEditRejected>,
+}
+
 #[allow(clippy::too_many_arguments)]
 fn panels(
     mut contexts: EguiContexts,
@@ -140,6 +152,7 @@ fn panels(
     site: Option<ResMut<Site>>,
     sun_sky: Option<Res<SunSky>>,
     mut sensors: SensorPanel,
+    mut materials: MaterialPanel,
     window: Single<&Window, With<PrimaryWindow>>,
     mut cameras: Query<&mut Camera, With<SunPassView>>,
 ) -> Result {
@@ -150,6 +163,8 @@ fn panels(
         .show(&mut root, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
                 sun_and_sky_panel(ui, &mut ui_state, &mut solar, &mut sky, &mut settings, site, sun_sky.as_deref());
+                ui.separator();
+                material_panel(ui, &mut ui_state, &sensors.active, &mut materials);
             });
         })
         .response
@@ -395,6 +410,91 @@ fn view_panel(ui: &mut Ui, state: &mut UiState, settings: &mut ResMut<RenderSett
     if ui.button("Save image (PNG)").clicked() {
         state.save_image = true;
     }
+}
+
+/// Every material: diffuse reflectances, and for windows glass (with its
+/// transmittance) or a registered panel (with its keys, as in the scene
+/// file). Each change relights; a panel whose keys do not build keeps the
+/// material it had and says why.
+fn material_panel(ui: &mut Ui, state: &mut UiState, active: &ActiveScene, panel: &mut MaterialPanel) {
+    for rejected in panel.rejected.read() {
+        state.note = Some(rejected.message.clone());
+    }
+    let Some(scene) = &active.scene else { return };
+    egui::CollapsingHeader::new("Materials").default_open(true).show(ui, |ui| {
+        let catalog = panel.registry.as_ref().map(|r| r.catalog()).unwrap_or_default();
+        let base = crate::panel::base_dir(&scene.files.scene);
+        for (index, material) in scene.materials.iter().enumerate() {
+            let index = index as u32;
+            ui.label(egui::RichText::new(&material.name).strong());
+            match &material.kind {
+                MaterialKind::Diffuse { reflectance } => {
+                    let mut rgb = reflectance.0;
+                    let response = ui.horizontal(|ui| {
+                        let mut changed = false;
+                        for (c, label) in ["R", "G", "B"].iter().enumerate() {
+                            let r = ui.add(egui::DragValue::new(&mut rgb[c]).range(0.0..=1.0).speed(0.005).prefix(*label));
+                            changed |= r.drag_stopped() || (r.changed() && !r.dragged());
+                        }
+                        changed
+                    });
+                    if response.inner {
+                        panel.edits.write(EditMaterial { index, kind: MaterialKind::Diffuse { reflectance: Rgb(rgb) } });
+                    }
+                }
+                MaterialKind::Glass { .. } | MaterialKind::Panel { .. } => {
+                    let current = match &material.kind {
+                        MaterialKind::Panel { panel, .. } => panel.clone(),
+                        _ => "glass".to_string(),
+                    };
+                    let mut chosen = current.clone();
+                    egui::ComboBox::from_id_salt(("window_material", index)).selected_text(&chosen).show_ui(ui, |ui| {
+                        ui.selectable_value(&mut chosen, "glass".to_string(), "glass");
+                        for name in catalog.names() {
+                            ui.selectable_value(&mut chosen, name.to_string(), name);
+                        }
+                    });
+                    if let MaterialKind::Glass { transmittance } = &material.kind
+                        && chosen == "glass"
+                    {
+                        let mut t = *transmittance;
+                        let r = ui.add(egui::Slider::new(&mut t, 0.0..=1.0).text("transmittance"));
+                        if r.drag_stopped() || (r.changed() && !r.dragged()) {
+                            panel.edits.write(EditMaterial { index, kind: MaterialKind::Glass { transmittance: t } });
+                        }
+                    }
+                    let text = state.panel_text.entry(index).or_insert_with(|| match &material.kind {
+                        MaterialKind::Panel { parameters, .. } => toml::to_string(parameters).unwrap_or_default(),
+                        _ => String::new(),
+                    });
+                    if chosen == "glass" && current != "glass" {
+                        panel.edits.write(EditMaterial { index, kind: MaterialKind::Glass { transmittance: 0.88 } });
+                    } else if chosen != "glass" {
+                        ui.add(egui::TextEdit::multiline(text).desired_rows(3).code_editor());
+                        if ui.button("Apply").clicked() || chosen != current {
+                            let parameters = Parameters::from_toml(text, base.clone());
+                            let built = parameters.map_err(|e| format!("{}: {e}", material.name)).and_then(|p| {
+                                let model = catalog.build(&chosen, &p).map_err(|e| format!("{}: {}: {}", material.name, e.key, e.message))?;
+                                let up = match &material.kind {
+                                    MaterialKind::Panel { up, .. } => *up,
+                                    _ => None,
+                                };
+                                Ok(MaterialKind::Panel { panel: chosen.clone(), up, parameters: p.values, model: crate::panel::PanelHandle(model) })
+                            });
+                            match built {
+                                Ok(kind) => {
+                                    state.note = None;
+                                    panel.edits.write(EditMaterial { index, kind });
+                                }
+                                // The material keeps what it had.
+                                Err(message) => state.note = Some(message),
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    });
 }
 
 /// Camera presets, the scene's and the user's viewpoints, walk mode.
