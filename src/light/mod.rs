@@ -249,6 +249,9 @@ pub struct Lighting {
     pub sensors: Vec<SensorReading>,
     /// Jacobi iterations used.
     pub iterations: usize,
+    /// The last iteration's largest change of a patch side's indirect light,
+    /// relative to its irradiance (infinite before the first).
+    pub residual: f64,
 }
 
 /// Maps `f` over `0..count` on `threads` threads (all cores when `None`);
@@ -645,6 +648,7 @@ impl LightModel {
             indirect,
             sensors,
             iterations: 0,
+            residual: f64::INFINITY,
             converged: false,
         }
     }
@@ -699,6 +703,7 @@ pub struct Relight<'a> {
     indirect: Vec<[f64; 3]>,
     sensors: Vec<SensorDirect>,
     iterations: usize,
+    residual: f64,
     converged: bool,
 }
 
@@ -733,6 +738,7 @@ impl Relight<'_> {
             .fold(0.0, f64::max);
         self.indirect = next;
         self.iterations += 1;
+        self.residual = change;
         self.converged = change <= model.settings.tolerance || self.iterations >= model.settings.max_iterations;
         self.converged
     }
@@ -784,7 +790,7 @@ impl Relight<'_> {
                 }
             })
             .collect();
-        Lighting { sides, sensors, iterations: self.iterations }
+        Lighting { sides, sensors, iterations: self.iterations, residual: self.residual }
     }
 }
 

@@ -1,4 +1,5 @@
-//! A CAD-like camera: left-drag orbits about the focus, right- or middle-drag
+//! A CAD-like camera: left-drag orbits about the point under the cursor
+//! where it pressed (the focus moves there; the eye stays), right- or middle-drag
 //! pans, the wheel zooms toward the point under the cursor, `F` frames the
 //! whole model. In walk mode (a panel checkbox) W/A/S/D move the eye at its
 //! height and left-drag looks around from it. z is up.
@@ -68,6 +69,7 @@ pub fn navigate(
     window: Single<&Window, With<PrimaryWindow>>,
     active: Res<ActiveScene>,
     ui: Option<Res<super::ui::UiState>>,
+    ray_model: Option<Res<crate::render::RayModel>>,
     time: Res<Time>,
     mut cameras: Query<(&mut CadCamera, &mut Transform, &Camera, &GlobalTransform, &Projection)>,
 ) {
@@ -82,6 +84,20 @@ pub fn navigate(
             _ => std::f32::consts::FRAC_PI_3,
         };
         let delta = motion.delta;
+        let cursor_ray = window.cursor_position().and_then(|cursor| {
+            // Cursor positions are in the window; the camera's are in its viewport.
+            let offset = camera.viewport.as_ref().map_or(Vec2::ZERO, |v| v.physical_position.as_vec2() / window.scale_factor());
+            camera.viewport_to_world(global, cursor - offset).ok()
+        });
+        if mouse.just_pressed(MouseButton::Left)
+            && !walking
+            && let (Some(ray), Some(model)) = (cursor_ray, ray_model.as_ref())
+            && let Some((_, distance)) = model.0.trace(ray.origin.as_dvec3(), ray.direction.as_vec3().as_dvec3())
+        {
+            // Orbit about the point under the cursor.
+            let eye = cad.eye();
+            *cad = CadCamera::looking(eye, ray.origin + ray.direction * distance as f32);
+        }
         if mouse.pressed(MouseButton::Left) && delta != Vec2::ZERO {
             let eye = cad.eye();
             cad.yaw -= delta.x * ORBIT_SPEED;
@@ -119,9 +135,7 @@ pub fn navigate(
             let factor = ZOOM_STEP.powf(lines);
             // Scale the eye and the focus about the point under the cursor on
             // the plane through the focus facing the camera.
-            let anchor = window
-                .cursor_position()
-                .and_then(|cursor| camera.viewport_to_world(global, cursor).ok())
+            let anchor = cursor_ray
                 .and_then(|ray| {
                     let normal = global.forward().as_vec3();
                     let t = ray.intersect_plane(cad.focus, InfinitePlane3d::new(normal))?;

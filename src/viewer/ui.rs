@@ -401,8 +401,12 @@ fn view_panel(ui: &mut Ui, state: &mut UiState, settings: &mut ResMut<RenderSett
     let progress = match (engine, lighting) {
         (Some(e), _) if e.is_precomputing() => "precomputing the light…".to_string(),
         (_, Some(l)) if l.lighting.is_some() => {
-            let iterations = l.lighting.as_ref().map_or(0, |x| x.iterations);
-            if l.converged { format!("light converged ({iterations} iterations)") } else { format!("light settling… iteration {iterations}") }
+            let (iterations, residual) = l.lighting.as_ref().map_or((0, f64::INFINITY), |x| (x.iterations, x.residual));
+            if l.converged {
+                format!("light converged ({iterations} iterations, residual {residual:.1e})")
+            } else {
+                format!("light settling… iteration {iterations}, residual {residual:.1e}")
+            }
         }
         _ => "waiting for the light".to_string(),
     };
