@@ -127,6 +127,10 @@ pub fn false_colour(lux: f32, top: f32) -> [f32; 3] {
     [0, 1, 2].map(|c| STOPS[i][c] * (1.0 - f) + STOPS[i + 1][c] * f)
 }
 
+/// Query filter for the cameras a person looks through (not the
+/// physical-units ones beside them).
+pub type PictureCamera = (With<SunPassView>, Without<PhysicalUnits>);
+
 /// A camera whose image holds physical values: luminance in cd/m² (its
 /// exposure factor is 1 and it has no tone mapping); automatic exposure
 /// leaves it alone.

@@ -255,16 +255,20 @@ fn capture(mut commands: Commands, mut job: ResMut<Job>) {
     });
     let out = job.physical.clone();
     commands.spawn(Screenshot::image(physical)).observe(move |captured: On<ScreenshotCaptured>| {
-        let pixels = captured
-            .image
-            .data
-            .as_deref()
-            .unwrap_or_default()
-            .chunks_exact(16)
-            .map(|p| [0, 4, 8].map(|o| f32::from_le_bytes([p[o], p[o + 1], p[o + 2], p[o + 3]])))
-            .collect();
-        *out.lock().expect("offscreen physical lock") = Some(pixels);
+        *out.lock().expect("offscreen physical lock") = Some(float_pixels(&captured.image));
     });
+}
+
+/// The RGB of an Rgba32Float image, row-major. Rows read back from the GPU
+/// may be padded (to 256 bytes): the padding is skipped.
+pub fn float_pixels(image: &Image) -> Vec<[f32; 3]> {
+    let data = image.data.as_deref().unwrap_or_default();
+    let (width, height) = (image.width() as usize, image.height().max(1) as usize);
+    let row = (data.len() / height).max(width * 16);
+    data.chunks(row)
+        .flat_map(|line| line[..(width * 16).min(line.len())].chunks_exact(16))
+        .map(|p| [0, 4, 8].map(|o| f32::from_le_bytes([p[o], p[o + 1], p[o + 2], p[o + 3]])))
+        .collect()
 }
 
 fn finish(job: Res<Job>, mut exit: MessageWriter<AppExit>) {

@@ -12,7 +12,6 @@ use bevy::tasks::{AsyncComputeTaskPool, Task, block_on, futures_lite::future};
 
 use crate::ecs::{LightEngine, LightingState, Site, SkyChoice, SolarTime};
 use crate::light::LightModel;
-use crate::render::sun_pass::SunPassView;
 use crate::sky::{Sky, SkySpec};
 use crate::sun::solar_position;
 use crate::time::{Date, LocalDateTime, TimeOfDay};
@@ -114,7 +113,7 @@ pub fn draw_markers(
     selected: Res<SelectedSensor>,
     mut contexts: bevy_egui::EguiContexts,
     lighting: Option<Res<LightingState>>,
-    camera: Query<(&Camera, &GlobalTransform), With<SunPassView>>,
+    camera: Query<(&Camera, &GlobalTransform), crate::render::PictureCamera>,
 ) -> Result {
     let Some(scene) = &active.scene else { return Ok(()) };
     let Ok((camera, transform)) = camera.single() else { return Ok(()) };
@@ -150,7 +149,7 @@ pub fn pick_sensor(
     window: Single<&Window, bevy::ecs::query::With<bevy::window::PrimaryWindow>>,
     active: Res<crate::ecs::ActiveScene>,
     ui: Res<super::ui::UiState>,
-    camera: Query<(&Camera, &GlobalTransform), With<SunPassView>>,
+    camera: Query<(&Camera, &GlobalTransform), crate::render::PictureCamera>,
     mut pressed_at: Local<Option<Vec2>>,
     mut selected: ResMut<SelectedSensor>,
 ) {

@@ -22,7 +22,6 @@ use crate::ecs::{ActiveScene, EditMaterial, LightEngine, LightingState, Material
 use crate::panel::Parameters;
 use crate::scene::{MaterialKind, Rgb};
 use crate::scene::Viewpoint;
-use crate::render::sun_pass::SunPassView;
 use crate::render::{RenderMode, RenderSettings};
 use crate::sky::perez;
 use crate::sky::SkySpec;
@@ -154,7 +153,7 @@ fn panels(
     mut sensors: SensorPanel,
     mut materials: MaterialPanel,
     window: Single<&Window, With<PrimaryWindow>>,
-    mut cameras: Query<&mut Camera, With<SunPassView>>,
+    mut cameras: Query<&mut Camera, crate::render::PictureCamera>,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(ctx.clone(), "viewport".into(), UiBuilder::new().layer_id(LayerId::background()).max_rect(ctx.viewport_rect()));
