@@ -274,17 +274,17 @@ fn sun_and_sky_panel(
         ui.label("Site");
         let mut s = site.0;
         ui.horizontal(|ui| {
-            ui.add(egui::DragValue::new(&mut s.latitude).range(-90.0..=90.0).speed(0.1).prefix("lat "));
-            ui.add(egui::DragValue::new(&mut s.longitude).range(-180.0..=180.0).speed(0.1).prefix("lon "));
+            bounded(ui, &mut s.latitude, -90.0..=90.0, 0.1, "lat ", "", &mut state.note);
+            bounded(ui, &mut s.longitude, -180.0..=180.0, 0.1, "lon ", "", &mut state.note);
         });
-        ui.add(egui::DragValue::new(&mut s.timezone).range(-14.0..=14.0).speed(0.25).prefix("UTC "));
+        bounded(ui, &mut s.timezone, -14.0..=14.0, 0.25, "UTC ", "", &mut state.note);
         if s != site.0 {
             site.0 = s;
         }
         sun_path(ui, &site.0, solar.0);
     }
     ui.separator();
-    sky_controls(ui, sky);
+    sky_controls(ui, sky, &mut state.note);
     ui.separator();
     let mut auto = settings.exposure.is_none();
     let mut ev = settings.exposure.unwrap_or(10.0);
@@ -299,6 +299,18 @@ fn sun_and_sky_panel(
     if let Some(note) = &state.note {
         ui.colored_label(egui::Color32::from_rgb(230, 160, 60), note);
     }
+}
+
+/// A number field: what is typed outside `range` is clamped into it, with a
+/// note saying so (never a panic, never a silent change).
+fn bounded(ui: &mut Ui, value: &mut f64, range: std::ops::RangeInclusive<f64>, speed: f64, prefix: &str, suffix: &str, note: &mut Option<String>) -> egui::Response {
+    let response = ui.add(egui::DragValue::new(value).speed(speed).prefix(prefix).suffix(suffix));
+    if !range.contains(value) {
+        let clamped = if value.is_nan() { *range.start() } else { value.clamp(*range.start(), *range.end()) };
+        *note = Some(format!("{}{value}{suffix} is outside {}..{}: {clamped} is used", prefix.trim_start(), range.start(), range.end()));
+        *value = clamped;
+    }
+    response
 }
 
 /// A map-free sun-path diagram: today's arc (altitude against azimuth, the
@@ -328,7 +340,7 @@ fn sun_path(ui: &mut Ui, site: &crate::site::Site, now: LocalDateTime) {
 }
 
 /// The sky type and its parameters.
-fn sky_controls(ui: &mut Ui, sky: &mut ResMut<SkyChoice>) {
+fn sky_controls(ui: &mut Ui, sky: &mut ResMut<SkyChoice>, note: &mut Option<String>) {
     let names = ["clear", "turbid", "intermediate", "overcast", "uniform", "perez", "cie"];
     let current = match &sky.0 {
         SkySpec::Clear { turbidity } if *turbidity > 4.0 => "turbid",
@@ -362,13 +374,13 @@ fn sky_controls(ui: &mut Ui, sky: &mut ResMut<SkyChoice>) {
             ui.add(egui::Slider::new(turbidity, 1.0..=10.0).text("turbidity"));
         }
         SkySpec::Perez(perez::Input::Irradiance { direct_normal, diffuse_horizontal }) => {
-            ui.add(egui::DragValue::new(direct_normal).range(0.0..=1100.0).prefix("DNI ").suffix(" W/m²"));
-            ui.add(egui::DragValue::new(diffuse_horizontal).range(1.0..=600.0).prefix("DHI ").suffix(" W/m²"));
+            bounded(ui, direct_normal, 0.0..=1100.0, 1.0, "DNI ", " W/m²", note);
+            bounded(ui, diffuse_horizontal, 1.0..=600.0, 1.0, "DHI ", " W/m²", note);
         }
         SkySpec::Cie { standard_type, diffuse_illuminance, direct_illuminance } => {
             ui.add(egui::Slider::new(standard_type, 1..=15).text("CIE type"));
-            ui.add(egui::DragValue::new(diffuse_illuminance).range(100.0..=60_000.0).prefix("diffuse ").suffix(" lx"));
-            ui.add(egui::DragValue::new(direct_illuminance).range(0.0..=120_000.0).prefix("direct ").suffix(" lx"));
+            bounded(ui, diffuse_illuminance, 100.0..=60_000.0, 50.0, "diffuse ", " lx", note);
+            bounded(ui, direct_illuminance, 0.0..=120_000.0, 100.0, "direct ", " lx", note);
         }
         _ => {}
     }
@@ -687,5 +699,25 @@ fn false_colour_legend(ui: &mut Ui, top: f32) {
         let lux = top / 10f32.powi(3 - decade);
         let x = rect.left() + rect.width() * decade as f32 / 3.0;
         painter.text(egui::pos2(x, rect.bottom()), egui::Align2::CENTER_BOTTOM, format!("{lux:.0}"), egui::FontId::proportional(10.0), egui::Color32::LIGHT_GRAY);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn typed_values_out_of_range_are_clamped_with_a_note() {
+        let ctx = egui::Context::default();
+        let (mut latitude, mut ok, mut note) = (123.0, 42.0, None);
+        let mut output = ctx.run_ui(egui::RawInput::default(), |ui| {
+            bounded(ui, &mut ok, -90.0..=90.0, 0.1, "lat ", "", &mut note);
+            assert!(note.is_none());
+            bounded(ui, &mut latitude, -90.0..=90.0, 0.1, "lat ", "", &mut note);
+        });
+        // Nothing draws the frame here: its font textures are dropped on purpose.
+        output.textures_delta.clear();
+        assert_eq!((ok, latitude), (42.0, 90.0));
+        assert_eq!(note.as_deref(), Some("lat 123 is outside -90..90: 90 is used"));
     }
 }
