@@ -423,3 +423,37 @@ fn material_edits_relight_and_impossible_ones_are_refused() {
     // Half the glass transmittance at normal incidence: about half the daylight.
     assert!(after < 0.6 * before && after > 0.4 * before, "{before} -> {after}");
 }
+
+/// The camera panel's requests, as its buttons make them: a preset looks at
+/// the whole model from where it says, a saved view joins the list and can
+/// be gone back to.
+#[test]
+fn camera_requests_move_the_camera_and_save_views() {
+    use heliodon::viewer::camera::CadCamera;
+    use heliodon::viewer::ui::{CameraRequest, UiState, apply_camera_request};
+
+    let mut app = headless_app();
+    app.init_resource::<UiState>().add_systems(Update, apply_camera_request);
+    open(&mut app, heliodon::bundled_scene("test_room")).unwrap();
+    let camera = app.world_mut().spawn(CadCamera::looking(Vec3::new(2.0, 5.0, 1.6), Vec3::new(2.0, 0.0, 1.2))).id();
+    let scene = app.world().resource::<ActiveScene>().scene.clone().unwrap();
+    let (centre, distance) = heliodon::render::framing(scene.bounds, heliodon::scene::DEFAULT_FOV);
+    app.world_mut().resource_mut::<UiState>().camera_request = Some(CameraRequest::Top);
+    app.update();
+    let top = *app.world().get::<CadCamera>(camera).unwrap();
+    assert!((top.focus - centre).length() < 1e-5 && (top.distance - distance).abs() < 1e-4);
+    assert!(top.eye().z > centre.z + 0.99 * distance, "from above: {:?}", top.eye());
+    app.world_mut().resource_mut::<UiState>().camera_request = Some(CameraRequest::Save);
+    app.update();
+    let saved = app.world().resource::<UiState>().saved_views.clone();
+    assert_eq!(saved.len(), 1);
+    assert!((saved[0].eye - top.eye()).length() < 1e-4);
+    app.world_mut().resource_mut::<UiState>().camera_request = Some(CameraRequest::Front);
+    app.update();
+    let front = *app.world().get::<CadCamera>(camera).unwrap();
+    assert!(front.eye().y < centre.y - 0.99 * distance, "from the south: {:?}", front.eye());
+    app.world_mut().resource_mut::<UiState>().camera_request = Some(CameraRequest::Viewpoint(saved[0].clone()));
+    app.update();
+    let back = *app.world().get::<CadCamera>(camera).unwrap();
+    assert!((back.eye() - top.eye()).length() < 1e-3);
+}
