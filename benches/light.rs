@@ -2,7 +2,11 @@
 //! scenes and a generated floor of offices (≥ 50,000 patches), and that
 //! building's memory.
 
+#[path = "../tests/support/quad_obj.rs"]
+mod quad_obj;
+
 use std::fmt::Write as _;
+use quad_obj::QuadObj;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -26,20 +30,11 @@ fn sky_at(scene: &Scene, hours: f64) -> Sky {
 /// of 0.25 m. Written as OBJ + scene files into `dir`.
 fn large_building(dir: &Path) -> PathBuf {
     let (w, d, h) = (60.0f64, 30.0f64, 3.0f64);
-    let mut obj = String::from("mtllib model.mtl\n");
-    let mut vertices = 0;
-    let mut quad = |obj: &mut String, material: &str, p: [[f64; 3]; 4]| {
-        let _ = writeln!(obj, "usemtl {material}");
-        for v in p {
-            let _ = writeln!(obj, "v {} {} {}", v[0], v[1], v[2]);
-        }
-        let _ = writeln!(obj, "f {} {} {} {}", vertices + 1, vertices + 2, vertices + 3, vertices + 4);
-        vertices += 4;
-    };
-    quad(&mut obj, "floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
-    quad(&mut obj, "ceiling", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
-    quad(&mut obj, "wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
-    quad(&mut obj, "wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
+    let mut obj = QuadObj::new("model.mtl");
+    obj.quad("floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
+    obj.quad("ceiling", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
+    obj.quad("wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
+    obj.quad("wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
     for (y, inward) in [(0.0, 1.0), (d, -1.0)] {
         for k in 0..15 {
             let x0 = 4.0 * k as f64;
@@ -47,25 +42,25 @@ fn large_building(dir: &Path) -> PathBuf {
             let facade = |z0: f64, z1: f64, xa: f64, xb: f64| {
                 if inward > 0.0 { [[xb, y, z0], [xa, y, z0], [xa, y, z1], [xb, y, z1]] } else { [[xa, y, z0], [xb, y, z0], [xb, y, z1], [xa, y, z1]] }
             };
-            quad(&mut obj, "wall", facade(0.0, 0.9, x0, x0 + 4.0));
-            quad(&mut obj, "wall", facade(2.4, h, x0, x0 + 4.0));
+            obj.quad("wall", facade(0.0, 0.9, x0, x0 + 4.0));
+            obj.quad("wall", facade(2.4, h, x0, x0 + 4.0));
             for (xa, xb, material) in [(x0, x0 + 0.3, "wall"), (x0 + 0.3, x0 + 1.9, "glass"), (x0 + 1.9, x0 + 2.1, "wall"), (x0 + 2.1, x0 + 3.7, "glass"), (x0 + 3.7, x0 + 4.0, "wall")] {
-                quad(&mut obj, material, facade(0.9, 2.4, xa, xb));
+                obj.quad(material, facade(0.9, 2.4, xa, xb));
             }
             // Partition to the next office and the corridor wall.
             let (ya, yb) = if inward > 0.0 { (0.0, 12.0) } else { (d - 12.0, d) };
             if k > 0 {
-                quad(&mut obj, "partition", [[x0, ya, 0.0], [x0, yb, 0.0], [x0, yb, h], [x0, ya, h]]);
+                obj.quad("partition", [[x0, ya, 0.0], [x0, yb, 0.0], [x0, yb, h], [x0, ya, h]]);
             }
             let yc = if inward > 0.0 { 12.0 } else { d - 12.0 };
-            quad(&mut obj, "partition", [[x0, yc, 0.0], [x0 + 4.0, yc, 0.0], [x0 + 4.0, yc, h], [x0, yc, h]]);
+            obj.quad("partition", [[x0, yc, 0.0], [x0 + 4.0, yc, 0.0], [x0 + 4.0, yc, h], [x0, yc, h]]);
             // A desk top.
             let yd = y + inward * 3.0;
-            quad(&mut obj, "desk", [[x0 + 1.0, yd - 0.4, 0.75], [x0 + 3.0, yd - 0.4, 0.75], [x0 + 3.0, yd + 0.4, 0.75], [x0 + 1.0, yd + 0.4, 0.75]]);
+            obj.quad("desk", [[x0 + 1.0, yd - 0.4, 0.75], [x0 + 3.0, yd - 0.4, 0.75], [x0 + 3.0, yd + 0.4, 0.75], [x0 + 1.0, yd + 0.4, 0.75]]);
         }
     }
     std::fs::create_dir_all(dir).unwrap();
-    std::fs::write(dir.join("model.obj"), obj).unwrap();
+    std::fs::write(dir.join("model.obj"), obj.text()).unwrap();
     std::fs::write(
         dir.join("model.mtl"),
         "newmtl floor\nKd 0.2 0.2 0.2\nnewmtl ceiling\nKd 0.8 0.8 0.8\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl partition\nKd 0.6 0.6 0.6\nnewmtl desk\nKd 0.4 0.35 0.3\nnewmtl glass\nd 0.12\n",

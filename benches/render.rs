@@ -5,7 +5,10 @@
 //! passes are what grows with the model). Prints the passes and shadow-volume
 //! triangles drawn per frame.
 
-use std::fmt::Write as _;
+#[path = "../tests/support/quad_obj.rs"]
+mod quad_obj;
+
+use quad_obj::QuadObj;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -23,41 +26,32 @@ const HEIGHT: u32 = 720;
 /// A 60 × 40 m hall with a glazed south façade and 8,400 boxes (desks,
 /// cabinets) on its floor: about 100k triangles.
 fn hall(dir: &Path) -> PathBuf {
-    let mut obj = String::from("mtllib model.mtl\n");
-    let mut vertices = 0;
-    let mut quad = |obj: &mut String, material: &str, p: [[f64; 3]; 4]| {
-        let _ = writeln!(obj, "usemtl {material}");
-        for v in p {
-            let _ = writeln!(obj, "v {} {} {}", v[0], v[1], v[2]);
-        }
-        let _ = writeln!(obj, "f {} {} {} {}", vertices + 1, vertices + 2, vertices + 3, vertices + 4);
-        vertices += 4;
-    };
+    let mut obj = QuadObj::new("model.mtl");
     let (w, d, h) = (60.0, 40.0, 4.0);
-    quad(&mut obj, "floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
-    quad(&mut obj, "ceiling", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
-    quad(&mut obj, "wall", [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]]);
-    quad(&mut obj, "wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
-    quad(&mut obj, "wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
-    quad(&mut obj, "wall", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, 0.0, 1.0], [0.0, 0.0, 1.0]]);
-    quad(&mut obj, "wall", [[0.0, 0.0, 3.0], [w, 0.0, 3.0], [w, 0.0, h], [0.0, 0.0, h]]);
-    quad(&mut obj, "glass", [[0.0, 0.0, 1.0], [w, 0.0, 1.0], [w, 0.0, 3.0], [0.0, 0.0, 3.0]]);
+    obj.quad("floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
+    obj.quad("ceiling", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
+    obj.quad("wall", [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]]);
+    obj.quad("wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
+    obj.quad("wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
+    obj.quad("wall", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, 0.0, 1.0], [0.0, 0.0, 1.0]]);
+    obj.quad("wall", [[0.0, 0.0, 3.0], [w, 0.0, 3.0], [w, 0.0, h], [0.0, 0.0, h]]);
+    obj.quad("glass", [[0.0, 0.0, 1.0], [w, 0.0, 1.0], [w, 0.0, 3.0], [0.0, 0.0, 3.0]]);
     for i in 0..120 {
         for j in 0..70 {
             let (x, y) = (0.5 + 0.49 * f64::from(i), 2.0 + 0.54 * f64::from(j));
             let (a, b, top) = ([x, y], [x + 0.3, y + 0.3], 0.5 + 0.25 * f64::from((i + j) % 3));
             let c = |p: [f64; 2], z: f64| [p[0], p[1], z];
             let (p00, p10, p11, p01) = ([a[0], a[1]], [b[0], a[1]], [b[0], b[1]], [a[0], b[1]]);
-            quad(&mut obj, "box", [c(p00, top), c(p10, top), c(p11, top), c(p01, top)]);
-            quad(&mut obj, "box", [c(p00, 0.0), c(p10, 0.0), c(p10, top), c(p00, top)]);
-            quad(&mut obj, "box", [c(p10, 0.0), c(p11, 0.0), c(p11, top), c(p10, top)]);
-            quad(&mut obj, "box", [c(p11, 0.0), c(p01, 0.0), c(p01, top), c(p11, top)]);
-            quad(&mut obj, "box", [c(p01, 0.0), c(p00, 0.0), c(p00, top), c(p01, top)]);
-            quad(&mut obj, "box", [c(p00, 0.0), c(p01, 0.0), c(p11, 0.0), c(p10, 0.0)]);
+            obj.quad("box", [c(p00, top), c(p10, top), c(p11, top), c(p01, top)]);
+            obj.quad("box", [c(p00, 0.0), c(p10, 0.0), c(p10, top), c(p00, top)]);
+            obj.quad("box", [c(p10, 0.0), c(p11, 0.0), c(p11, top), c(p10, top)]);
+            obj.quad("box", [c(p11, 0.0), c(p01, 0.0), c(p01, top), c(p11, top)]);
+            obj.quad("box", [c(p01, 0.0), c(p00, 0.0), c(p00, top), c(p01, top)]);
+            obj.quad("box", [c(p00, 0.0), c(p01, 0.0), c(p11, 0.0), c(p10, 0.0)]);
         }
     }
     std::fs::create_dir_all(dir).unwrap();
-    std::fs::write(dir.join("model.obj"), obj).unwrap();
+    std::fs::write(dir.join("model.obj"), obj.text()).unwrap();
     std::fs::write(
         dir.join("model.mtl"),
         "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl ceiling\nKd 0.8 0.8 0.8\nnewmtl wall\nKd 0.6 0.6 0.6\nnewmtl box\nKd 0.5 0.45 0.4\nnewmtl glass\nd 0.7\n",

@@ -75,8 +75,9 @@ pub struct ViewArgs {
     pub sky: SkyArgs,
 }
 
+/// A scene at one date, time and sky: what `render` and `export-radiance` take.
 #[derive(clap::Args, Debug)]
-pub struct RenderArgs {
+pub struct SceneCase {
     /// Scene file (TOML)
     pub scene: PathBuf,
     /// Local date, YYYY-MM-DD
@@ -87,6 +88,18 @@ pub struct RenderArgs {
     pub time: TimeOfDay,
     #[command(flatten)]
     pub sky: SkyArgs,
+}
+
+impl SceneCase {
+    pub fn when(&self) -> LocalDateTime {
+        LocalDateTime { date: self.date, time: self.time }
+    }
+}
+
+#[derive(clap::Args, Debug)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub case: SceneCase,
     /// PNG file to write
     #[arg(long)]
     pub out: PathBuf,
@@ -183,16 +196,8 @@ pub struct SensorsArgs {
 
 #[derive(clap::Args, Debug)]
 pub struct ExportArgs {
-    /// Scene file (TOML)
-    pub scene: PathBuf,
-    /// Local date, YYYY-MM-DD
-    #[arg(long, value_parser = Date::parse)]
-    pub date: Date,
-    /// Local standard time, HH:MM
-    #[arg(long, value_parser = TimeOfDay::parse)]
-    pub time: TimeOfDay,
     #[command(flatten)]
-    pub sky: SkyArgs,
+    pub case: SceneCase,
     /// Folder to write scene.rad, sky.rad, sensors.pts, sensors.txt and run.sh into
     #[arg(long)]
     pub out: PathBuf,
@@ -318,7 +323,7 @@ pub fn main(add_panels: AddPanels) -> ExitCode {
                 ExitCode::FAILURE
             }
         },
-        Some(Command::Render(args)) => match render(&args, add_panels) {
+        Some(Command::Render(args)) => match render(&args, &panels, add_panels) {
             Ok(()) => ExitCode::SUCCESS,
             Err(error) => {
                 eprintln!("error: {error}");
@@ -359,15 +364,15 @@ fn sky_for(scene: &Scene, spec: &SkySpec, sky_name: &str, when: LocalDateTime) -
 
 /// The `export-radiance` command.
 pub fn export_radiance(args: &ExportArgs, panels: &PanelCatalog) -> Result<(), String> {
-    let spec = args.sky.spec()?;
-    let scene = load_for_command(&args.scene, panels)?;
-    let when = LocalDateTime { date: args.date, time: args.time };
-    let (position, sky) = sky_for(&scene, &spec, &args.sky.sky, when)?;
-    let case = format!(
+    let (case, spec) = (&args.case, args.case.sky.spec()?);
+    let scene = load_for_command(&case.scene, panels)?;
+    let when = case.when();
+    let (position, sky) = sky_for(&scene, &spec, &case.sky.sky, when)?;
+    let label = format!(
         "{} {} {} sky, sun altitude {:.4}°, azimuth {:.4}° (SPA)",
-        when.date, when.time, args.sky.sky, position.altitude, position.azimuth
+        when.date, when.time, case.sky.sky, position.altitude, position.azimuth
     );
-    crate::radiance::export(&scene, &sky, &case, &args.out)
+    crate::radiance::export(&scene, &sky, &label, &args.out)
 }
 
 /// How `view` starts: the time and sky given, and where to save a screenshot.
@@ -380,13 +385,13 @@ fn view_request(args: &ViewArgs) -> Result<crate::viewer::ViewStart, String> {
 }
 
 /// The `render` command.
-pub fn render(args: &RenderArgs, add_panels: AddPanels) -> Result<(), String> {
-    let sky = args.sky.spec()?;
-    let scene = load_for_command(&args.scene, &panel_catalog(add_panels))?;
+pub fn render(args: &RenderArgs, panels: &PanelCatalog, add_panels: AddPanels) -> Result<(), String> {
+    let (case, sky) = (&args.case, args.case.sky.spec()?);
+    let scene = load_for_command(&case.scene, panels)?;
     let mut view = match &args.camera {
         Some(name) => Some(scene.viewpoints.iter().find(|v| &v.name == name).cloned().ok_or_else(|| {
             let known: Vec<&str> = scene.viewpoints.iter().map(|v| v.name.as_str()).collect();
-            format!("--camera {name}: {} has no such camera (it has: {})", args.scene.display(), if known.is_empty() { "none".into() } else { known.join(", ") })
+            format!("--camera {name}: {} has no such camera (it has: {})", case.scene.display(), if known.is_empty() { "none".into() } else { known.join(", ") })
         })?),
         None => args.eye.zip(args.target).map(|(eye, target)| Viewpoint { name: "command line".into(), eye, target, fov: DEFAULT_FOV }),
     };
@@ -398,11 +403,11 @@ pub fn render(args: &RenderArgs, add_panels: AddPanels) -> Result<(), String> {
         view = Some(Viewpoint { fov: fov as f32, ..base });
     }
     let image = crate::render::offscreen::render(OffscreenRequest {
-        scene: args.scene.clone(),
+        scene: case.scene.clone(),
         view,
         width: args.width,
         height: args.height,
-        when: Some(LocalDateTime { date: args.date, time: args.time }),
+        when: Some(case.when()),
         sky: Some(sky),
         settings: RenderSettings { mode: args.mode, exposure: args.exposure.map(|e| e as f32), ..Default::default() },
         add_panels,

@@ -187,41 +187,54 @@ fn the_sun_and_sky_follow_the_clock_once_per_change() {
     assert!(app.world().resource::<SunSky>().sky.sun.is_none());
 }
 
-#[test]
-fn relights_run_as_tasks_and_the_last_change_wins() {
-    use heliodon::ecs::{LightCacheDir, LightEngine, LightingSettings, LightingState, LightingUpdated, SolarTime, SunSky};
+/// A headless app with a quick light engine and no cache, with the bundled
+/// scene `name` open.
+fn lit_app(name: &str) -> App {
+    use heliodon::ecs::{LightCacheDir, LightingSettings};
     use heliodon::light::LightSettings;
-    use heliodon::time::{LocalDateTime, TimeOfDay};
-
     let mut app = headless_app();
     let settings = LightSettings { rays_per_patch: 64, rays_per_sensor: 512, sun_samples_per_patch: 4, area_sensor_sun_grid: 4, ..Default::default() };
     app.insert_resource(LightingSettings(settings)).insert_resource(LightCacheDir(None));
-    open(&mut app, heliodon::bundled_scene("test_room")).unwrap();
-    let mut seen: Vec<u64> = Vec::new();
-    let run_until_settled = |app: &mut App, seen: &mut Vec<u64>| {
-        let deadline = Instant::now() + Duration::from_secs(120);
-        loop {
-            app.update();
-            seen.extend(app.world_mut().resource_mut::<Messages<LightingUpdated>>().drain().map(|m| m.generation));
-            let engine = app.world().resource::<LightEngine>();
-            let state = app.world().resource::<LightingState>();
-            if engine.model.is_some() && state.converged && state.generation == engine.generation() {
-                return;
-            }
-            assert!(Instant::now() < deadline, "lighting did not settle");
-            std::thread::sleep(Duration::from_millis(5));
+    open(&mut app, heliodon::bundled_scene(name)).unwrap();
+    app
+}
+
+/// Updates the app until its newest relight has converged; `each` sees it
+/// after every update.
+fn run_until_settled(app: &mut App, mut each: impl FnMut(&mut App)) {
+    use heliodon::ecs::{LightEngine, LightingState};
+    let deadline = Instant::now() + Duration::from_secs(120);
+    loop {
+        app.update();
+        each(app);
+        let engine = app.world().resource::<LightEngine>();
+        let state = app.world().resource::<LightingState>();
+        if engine.model.is_some() && state.converged && state.generation == engine.generation() {
+            return;
         }
-    };
-    run_until_settled(&mut app, &mut seen);
+        assert!(Instant::now() < deadline, "lighting did not settle");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+#[test]
+fn relights_run_as_tasks_and_the_last_change_wins() {
+    use heliodon::ecs::{LightEngine, LightingState, LightingUpdated, SolarTime, SunSky};
+    use heliodon::time::{LocalDateTime, TimeOfDay};
+
+    let mut app = lit_app("test_room");
+    let mut seen: Vec<u64> = Vec::new();
+    let mut record = |app: &mut App| seen.extend(app.world_mut().resource_mut::<Messages<LightingUpdated>>().drain().map(|m| m.generation));
+    run_until_settled(&mut app, &mut record);
     let first = app.world().resource::<LightingState>().generation;
     // Three changes of time in quick succession: one frame each.
     let date = app.world().resource::<SolarTime>().0.date;
     for hours in [9.0, 11.0, 15.5] {
         app.world_mut().resource_mut::<SolarTime>().0 = LocalDateTime { date, time: TimeOfDay::from_hours(hours).unwrap() };
         app.update();
-        seen.extend(app.world_mut().resource_mut::<Messages<LightingUpdated>>().drain().map(|m| m.generation));
+        record(&mut app);
     }
-    run_until_settled(&mut app, &mut seen);
+    run_until_settled(&mut app, &mut record);
     // Results arrived in order: never an older relight after a newer one.
     assert!(seen.windows(2).all(|w| w[0] <= w[1]), "{seen:?}");
     let world = app.world();
@@ -385,26 +398,14 @@ fn the_day_series_of_a_sensor_follows_the_sun() {
 /// a window (the edit is refused with a message).
 #[test]
 fn material_edits_relight_and_impossible_ones_are_refused() {
-    use heliodon::ecs::{ActiveScene, EditMaterial, LightCacheDir, LightEngine, LightingSettings, LightingState, MaterialEditRejected};
-    use heliodon::light::LightSettings;
+    use heliodon::ecs::{ActiveScene, EditMaterial, LightingState, MaterialEditRejected};
     use heliodon::scene::MaterialKind;
 
-    let mut app = headless_app();
-    let settings = LightSettings { rays_per_patch: 64, rays_per_sensor: 512, sun_samples_per_patch: 4, area_sensor_sun_grid: 4, ..Default::default() };
-    app.insert_resource(LightingSettings(settings)).insert_resource(LightCacheDir(None));
-    open(&mut app, heliodon::bundled_scene("test_room")).unwrap();
+    let mut app = lit_app("test_room");
+    // The room's total light once settled.
     let settle = |app: &mut App| -> f64 {
-        let deadline = Instant::now() + Duration::from_secs(120);
-        loop {
-            app.update();
-            let engine = app.world().resource::<LightEngine>();
-            let state = app.world().resource::<LightingState>();
-            if engine.model.is_some() && state.converged && state.generation == engine.generation() {
-                return state.lighting.as_ref().unwrap().sensors.iter().map(|s| s.total).sum();
-            }
-            assert!(Instant::now() < deadline, "lighting did not settle");
-            std::thread::sleep(Duration::from_millis(5));
-        }
+        run_until_settled(app, |_| {});
+        app.world().resource::<LightingState>().lighting.as_ref().unwrap().sensors.iter().map(|s| s.total).sum()
     };
     let before = settle(&mut app);
     let materials = app.world().resource::<ActiveScene>().scene.clone().unwrap().materials.clone();

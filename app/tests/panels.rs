@@ -2,6 +2,10 @@
 //! panels are known by name, a panel from a crate that only tests use is
 //! found the same way, and bad panel input gives one line naming the key.
 
+#[path = "../../tests/support/quad_obj.rs"]
+mod quad_obj;
+
+use quad_obj::QuadObj;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -121,47 +125,29 @@ fn bad_panel_keys_give_one_line_naming_the_key() {
 /// A closed 4 × 6 × 3 m room with a 2 × 1 m opening in its south wall,
 /// filled with `window` (a material table body) or left open (`None`).
 fn room(name: &str, window: Option<&str>) -> PathBuf {
+    room_with(name, window, false)
+}
+
+/// [`room`], with a 1 m deep overhang outside, 0.2 m above its window, when
+/// `overhang`: at winter noon it shades the top quarter of the window.
+fn room_with(name: &str, window: Option<&str>, overhang: bool) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("panel_room_{name}"));
     std::fs::create_dir_all(&dir).unwrap();
-    let mut obj = String::from("mtllib room.mtl\n");
-    let mut n = 0;
-    let mut quad = |obj: &mut String, material: &str, p: [[f64; 3]; 4]| {
-        obj.push_str(&format!("usemtl {material}\n"));
-        for v in p {
-            obj.push_str(&format!("v {} {} {}\n", v[0], v[1], v[2]));
-        }
-        obj.push_str(&format!("f {} {} {} {}\n", n + 1, n + 2, n + 3, n + 4));
-        n += 4;
-    };
+    let mut obj = QuadObj::new("room.mtl");
     let (w, d, h) = (4.0, 6.0, 3.0);
-    quad(
-        &mut obj,
+    obj.quad(
         "floor",
         [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]],
     );
-    quad(
-        &mut obj,
-        "wall",
-        [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]],
-    );
-    quad(
-        &mut obj,
-        "wall",
-        [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]],
-    );
-    quad(
-        &mut obj,
+    obj.quad("wall", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
+    obj.quad("wall", [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]]);
+    obj.quad(
         "wall",
         [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]],
     );
-    quad(
-        &mut obj,
-        "wall",
-        [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]],
-    );
+    obj.quad("wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
     // South wall around the opening x 1-3, z 1-2.
-    quad(
-        &mut obj,
+    obj.quad(
         "wall",
         [
             [0.0, 0.0, 0.0],
@@ -170,13 +156,11 @@ fn room(name: &str, window: Option<&str>) -> PathBuf {
             [0.0, 0.0, 1.0],
         ],
     );
-    quad(
-        &mut obj,
+    obj.quad(
         "wall",
         [[0.0, 0.0, 2.0], [w, 0.0, 2.0], [w, 0.0, h], [0.0, 0.0, h]],
     );
-    quad(
-        &mut obj,
+    obj.quad(
         "wall",
         [
             [0.0, 0.0, 1.0],
@@ -185,8 +169,7 @@ fn room(name: &str, window: Option<&str>) -> PathBuf {
             [0.0, 0.0, 2.0],
         ],
     );
-    quad(
-        &mut obj,
+    obj.quad(
         "wall",
         [
             [3.0, 0.0, 1.0],
@@ -196,8 +179,7 @@ fn room(name: &str, window: Option<&str>) -> PathBuf {
         ],
     );
     if window.is_some() {
-        quad(
-            &mut obj,
+        obj.quad(
             "window",
             [
                 [1.0, 0.0, 1.0],
@@ -207,7 +189,18 @@ fn room(name: &str, window: Option<&str>) -> PathBuf {
             ],
         );
     }
-    std::fs::write(dir.join("room.obj"), obj).unwrap();
+    if overhang {
+        obj.quad(
+            "wall",
+            [
+                [0.5, 0.0, 2.2],
+                [3.5, 0.0, 2.2],
+                [3.5, -1.0, 2.2],
+                [0.5, -1.0, 2.2],
+            ],
+        );
+    }
+    std::fs::write(dir.join("room.obj"), obj.text()).unwrap();
     std::fs::write(
         dir.join("room.mtl"),
         "newmtl floor\nKd 0.2 0.2 0.2\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl window\nd 0.1\n",
@@ -274,18 +267,37 @@ fn a_straight_lobe_passes_the_sun_as_an_opening_does() {
         let scene = Arc::new(load_scene(&path, &catalog).unwrap().scene);
         let model = heliodon::light::LightModel::precompute(scene.clone(), quick()).unwrap();
         let lighting = model.solve(&winter_noon(&scene), None);
-        lighting.sensors.iter().map(|s| (s.direct_sun, s.direct_sky)).collect()
+        lighting
+            .sensors
+            .iter()
+            .map(|s| (s.direct_sun, s.direct_sky))
+            .collect()
     };
     let open = direct(room("open", None));
-    let clear = direct(room("clear", Some("panel = \"grey_filter\"\ntransmittance = 1.0\n")));
-    let grey = direct(room("grey", Some("panel = \"grey_filter\"\ntransmittance = 0.4\n")));
-    assert!(open.iter().filter(|e| e.0 > 1000.0).count() >= 2, "the beam reaches the floor sensors: {open:?}");
+    let clear = direct(room(
+        "clear",
+        Some("panel = \"grey_filter\"\ntransmittance = 1.0\n"),
+    ));
+    let grey = direct(room(
+        "grey",
+        Some("panel = \"grey_filter\"\ntransmittance = 0.4\n"),
+    ));
+    assert!(
+        open.iter().filter(|e| e.0 > 1000.0).count() >= 2,
+        "the beam reaches the floor sensors: {open:?}"
+    );
     assert!(open.iter().all(|e| e.1 > 10.0), "the sky is seen: {open:?}");
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * a.max(1.0);
     for ((o, c), g) in open.iter().zip(&clear).zip(&grey) {
         // The sun along the lobe's beam, the sky through the panel's transfer.
-        assert!(close(o.0, c.0) && close(o.1, c.1), "open {o:?} vs clear panel {c:?}");
-        assert!(close(0.4 * o.0, g.0) && close(0.4 * o.1, g.1), "open {o:?} vs grey panel {g:?}");
+        assert!(
+            close(o.0, c.0) && close(o.1, c.1),
+            "open {o:?} vs clear panel {c:?}"
+        );
+        assert!(
+            close(0.4 * o.0, g.0) && close(0.4 * o.1, g.1),
+            "open {o:?} vs grey panel {g:?}"
+        );
     }
 }
 
@@ -390,19 +402,6 @@ fn panel_lobes_are_drawn_where_the_engine_puts_them() {
     }
 }
 
-/// The room with a 1 m deep overhang outside, 0.2 m above its window: at
-/// winter noon it shades the top quarter of the window from the sun.
-fn room_with_overhang(name: &str, window: &str) -> PathBuf {
-    let path = room(name, Some(window));
-    let obj_path = path.with_file_name("room.obj");
-    let mut obj = std::fs::read_to_string(&obj_path).unwrap();
-    let n = obj.lines().filter(|l| l.starts_with("v ")).count();
-    obj.push_str("usemtl wall\nv 0.5 0 2.2\nv 3.5 0 2.2\nv 3.5 -1.0 2.2\nv 0.5 -1.0 2.2\n");
-    obj.push_str(&format!("f {} {} {} {}\n", n + 1, n + 2, n + 3, n + 4));
-    std::fs::write(&obj_path, obj).unwrap();
-    path
-}
-
 /// Exterior shading acts on the real sun before the panel turns it into
 /// lobes: the overhang's shadow on a prismatic window keeps each lobe's
 /// light off part of the floor, in the engine and in the picture alike.
@@ -413,25 +412,58 @@ fn an_overhang_shades_the_lobes_of_a_panel() {
     use heliodon::render::{RenderMode, RenderSettings};
     use heliodon::scene::Viewpoint;
     use heliodon::time::{Date, LocalDateTime, TimeOfDay};
-    let path = room_with_overhang("overhang", "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n");
-    let view = Viewpoint { name: "floor".into(), eye: heliodon::glam::Vec3::new(2.0, 5.5, 2.5), target: heliodon::glam::Vec3::new(2.0, 2.0, 0.0), fov: 70.0 };
+    let path = room_with(
+        "overhang",
+        Some("panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n"),
+        true,
+    );
+    let view = Viewpoint {
+        name: "floor".into(),
+        eye: heliodon::glam::Vec3::new(2.0, 5.5, 2.5),
+        target: heliodon::glam::Vec3::new(2.0, 2.0, 0.0),
+        fov: 70.0,
+    };
     let request = OffscreenRequest {
         scene: path.clone(),
         view: Some(view),
         width: 320,
         height: 200,
-        when: Some(LocalDateTime { date: Date::new(2026, 12, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() }),
+        when: Some(LocalDateTime {
+            date: Date::new(2026, 12, 21).unwrap(),
+            time: TimeOfDay::from_hours(12.0).unwrap(),
+        }),
         sky: Some(heliodon::sky::SkySpec::Clear { turbidity: 2.45 }),
-        settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
+        settings: RenderSettings {
+            mode: RenderMode::Sun,
+            ..Default::default()
+        },
         add_panels: all_panels,
     };
     let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sun_overhang_prismatic.png");
     let result = compare_direct_sun(&request, &file).unwrap();
-    println!("overhang over a prismatic window: {result} -> {}", file.display());
+    println!(
+        "overhang over a prismatic window: {result} -> {}",
+        file.display()
+    );
     assert!(result.lit > 1000, "{result}");
-    assert!(result.agreement >= 0.99 && result.within >= 0.99, "{result}");
+    assert!(
+        result.agreement >= 0.99 && result.within >= 0.99,
+        "{result}"
+    );
     // And the overhang does shade: the same view without it has more sun.
-    let open = OffscreenRequest { scene: room("no_overhang", Some("panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n")), ..request };
-    let unshaded = compare_direct_sun(&open, &file.with_file_name("sun_no_overhang_prismatic.png")).unwrap();
-    assert!(result.lit < unshaded.lit * 9 / 10, "{} lit with the overhang, {} without", result.lit, unshaded.lit);
+    let open = OffscreenRequest {
+        scene: room(
+            "no_overhang",
+            Some("panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n"),
+        ),
+        ..request
+    };
+    let unshaded =
+        compare_direct_sun(&open, &file.with_file_name("sun_no_overhang_prismatic.png")).unwrap();
+    assert!(
+        result.lit < unshaded.lit * 9 / 10,
+        "{} lit with the overhang, {} without",
+        result.lit,
+        unshaded.lit
+    );
 }

@@ -1,8 +1,8 @@
 //! Sensors in the viewer: markers with their readings in the 3D view, a
 //! selected sensor (click a marker or a table row), and the selected
-//! sensor's illuminance over the current day, computed in the background
-//! with the light engine (every half hour, each solve warm-started from the
-//! previous one).
+//! sensor's illuminance over the current day (every half hour, each solve
+//! warm-started from the previous one) and, when asked, over the year,
+//! both computed in the background with the light engine.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -23,21 +23,44 @@ pub struct SelectedSensor(pub Option<usize>);
 /// Half-hour steps of the day plot.
 pub const DAY_STEPS: usize = 48;
 
-/// The selected sensor's total illuminance (lux) over the day, by half
-/// hour from 00:15; `None` while it is being computed.
-#[derive(Resource, Default)]
-pub struct DaySeries {
-    /// For which sensor, date, sky and site (a new one restarts it).
-    key: Option<(usize, Date, String)>,
-    task: Option<Task<Vec<f64>>>,
-    pub values: Option<Vec<f64>>,
+/// A result computed in the background for a key (what it was asked for).
+pub struct Background<K, T> {
+    key: Option<K>,
+    task: Option<Task<T>>,
+    /// The result, once done; `None` while computing or when not asked.
+    pub values: Option<T>,
 }
 
-impl DaySeries {
-    pub fn computing(&self) -> bool {
-        self.task.is_some()
+impl<K, T> Default for Background<K, T> {
+    fn default() -> Self {
+        Self { key: None, task: None, values: None }
     }
 }
+
+impl<K: PartialEq, T: Send + 'static> Background<K, T> {
+    /// Takes the result if the task has finished.
+    fn collect(&mut self) {
+        if let Some(task) = &mut self.task
+            && let Some(values) = block_on(future::poll_once(task))
+        {
+            self.values = Some(values);
+            self.task = None;
+        }
+    }
+
+    /// Starts `work` for `key` on the async compute pool, in place of
+    /// whatever was there.
+    fn start(&mut self, key: Option<K>, work: impl FnOnce() -> T + Send + 'static) {
+        self.key = key;
+        self.values = None;
+        self.task = Some(AsyncComputeTaskPool::get().spawn(async move { work() }));
+    }
+}
+
+/// The selected sensor's total illuminance (lux) over the day, by half
+/// hour from 00:15; keyed by sensor, date, sky and site (a new key restarts it).
+#[derive(Resource, Default)]
+pub struct DaySeries(pub Background<(usize, Date, String), Vec<f64>>);
 
 /// Days of the year map: every two weeks from 1 January.
 pub const YEAR_DAYS: usize = 26;
@@ -46,12 +69,10 @@ pub const YEAR_DAYS: usize = 26;
 /// thesis' figure 1.4h), computed in the background when asked for.
 #[derive(Resource, Default)]
 pub struct YearMap {
-    /// Sensor, year and sky it was asked for.
-    key: Option<(usize, i32, String)>,
-    task: Option<Task<Vec<Vec<f64>>>>,
+    /// Keyed by sensor, year and sky.
+    pub map: Background<(usize, i32, String), Vec<Vec<f64>>>,
     /// Days done, for the progress bar.
     done: Arc<AtomicUsize>,
-    pub values: Option<Vec<Vec<f64>>>,
     /// Set by the panel's button.
     pub requested: bool,
 }
@@ -59,7 +80,7 @@ pub struct YearMap {
 impl YearMap {
     /// Share done while computing.
     pub fn progress(&self) -> Option<f32> {
-        self.task.as_ref().map(|_| self.done.load(Ordering::Relaxed) as f32 / YEAR_DAYS as f32)
+        self.map.task.as_ref().map(|_| self.done.load(Ordering::Relaxed) as f32 / YEAR_DAYS as f32)
     }
 }
 
@@ -71,39 +92,31 @@ pub fn update_year_map(
     sky: Res<SkyChoice>,
     site: Option<Res<Site>>,
     engine: Option<Res<LightEngine>>,
-    mut map: ResMut<YearMap>,
+    mut year: ResMut<YearMap>,
 ) {
-    if let Some(task) = &mut map.task
-        && let Some(values) = block_on(future::poll_once(task))
-    {
-        map.values = Some(values);
-        map.task = None;
-    }
+    year.map.collect();
     let key = selected.0.map(|s| (s, solar.0.date.year, format!("{:?}", sky.0)));
-    if map.key.is_some() && map.key != key && map.task.is_none() {
+    if year.map.key.is_some() && year.map.key != key && year.map.task.is_none() {
         // What is shown no longer fits the sensor or sky.
-        map.values = None;
-        map.key = None;
+        year.map = Background::default();
     }
-    if !std::mem::take(&mut map.requested) {
+    if !std::mem::take(&mut year.requested) {
         return;
     }
     let (Some(sensor), Some(site), Some(model)) = (selected.0, site, engine.and_then(|e| e.model.clone())) else { return };
-    let (year, spec, site) = (solar.0.date.year, sky.0.clone(), site.0);
+    let (first, spec, site) = (solar.0.date.year, sky.0.clone(), site.0);
     let done = Arc::new(AtomicUsize::new(0));
-    map.done = done.clone();
-    map.key = key;
-    map.values = None;
-    map.task = Some(AsyncComputeTaskPool::get().spawn(async move {
+    year.done = done.clone();
+    year.map.start(key, move || {
         (0..YEAR_DAYS)
             .map(|k| {
-                let date = Date::new(year, 1, 1).expect("1 January").add_days(14 * k as i64);
+                let date = Date::new(first, 1, 1).expect("1 January").add_days(14 * k as i64);
                 let day = day_series(&model, sensor, &site, date, &spec);
                 done.fetch_add(1, Ordering::Relaxed);
                 day
             })
             .collect()
-    }));
+    });
 }
 
 /// Sensor markers: a small cross and, over it, its total lux.
@@ -180,7 +193,6 @@ pub fn pick_sensor(
 
 /// Starts the selected sensor's day series when the sensor, date, sky or
 /// site change, and collects it when done.
-#[allow(clippy::too_many_arguments)]
 pub fn update_day_series(
     selected: Res<SelectedSensor>,
     solar: Res<SolarTime>,
@@ -189,21 +201,14 @@ pub fn update_day_series(
     engine: Option<Res<LightEngine>>,
     mut series: ResMut<DaySeries>,
 ) {
-    if let Some(task) = &mut series.task
-        && let Some(values) = block_on(future::poll_once(task))
-    {
-        series.values = Some(values);
-        series.task = None;
-    }
+    series.0.collect();
     let (Some(sensor), Some(site), Some(model)) = (selected.0, site, engine.and_then(|e| e.model.clone())) else { return };
     let key = (sensor, solar.0.date, format!("{:?} {:?}", sky.0, site.0));
-    if series.key.as_ref() == Some(&key) {
+    if series.0.key.as_ref() == Some(&key) {
         return;
     }
     let (date, spec, site) = (solar.0.date, sky.0.clone(), site.0);
-    series.key = Some(key);
-    series.values = None;
-    series.task = Some(AsyncComputeTaskPool::get().spawn(async move { day_series(&model, sensor, &site, date, &spec) }));
+    series.0.start(Some(key), move || day_series(&model, sensor, &site, date, &spec));
 }
 
 /// A sensor's total lux every half hour of a day.

@@ -545,13 +545,13 @@ fn sensor_panel(ui: &mut Ui, state: &mut UiState, sensors: &mut SensorPanel, sol
     let readings = &lighting.sensors;
     if let Some(selected) = sensors.selected.0.and_then(|i| readings.get(i)) {
         ui.label(format!("{}: {:.0} lx over {} (every half hour)", selected.name, selected.total, solar.0.date));
-        match &sensors.series.values {
+        match &sensors.series.0.values {
             Some(values) => day_plot(ui, values, solar.0.time.hours()),
             None => {
                 ui.add(egui::Spinner::new());
             }
         }
-        match (&sensors.year.values, sensors.year.progress()) {
+        match (&sensors.year.map.values, sensors.year.progress()) {
             (_, Some(done)) => {
                 ui.add(egui::ProgressBar::new(done).text("the year, every two weeks…"));
             }
@@ -573,7 +573,7 @@ fn sensor_panel(ui: &mut Ui, state: &mut UiState, sensors: &mut SensorPanel, sol
             }
             state.note = Some(write_export("heliodon-sensors.csv", &csv));
         }
-        if let (Some(values), Some(i)) = (&sensors.series.values, sensors.selected.0)
+        if let (Some(values), Some(i)) = (&sensors.series.0.values, sensors.selected.0)
             && ui.button("Export day (CSV)").clicked()
         {
             let mut csv = String::from("time,illuminance_lux\n");
