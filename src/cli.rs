@@ -15,7 +15,7 @@ use crate::render::{RenderMode, RenderSettings};
 use crate::scene::{self, DEFAULT_FOV, MaterialKind, Scene, Viewpoint};
 use crate::light::{LightSettings, Lighting, cache};
 use crate::site::Site;
-use crate::sky::{Sky, SkyInputs, SkySpec};
+use crate::sky::{Sky, SkyInputs, SkySpec, sky_at};
 use crate::sun::{self, SolarPosition};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
 
@@ -356,9 +356,8 @@ fn load_for_command(path: &std::path::Path, panels: &PanelCatalog) -> Result<Sce
 
 /// The sun and sky of a scene's site at a local time.
 fn sky_for(scene: &Scene, spec: &SkySpec, sky_name: &str, when: LocalDateTime) -> Result<(SolarPosition, Sky), String> {
-    let position = sun::solar_position(&scene.site, &when);
-    let sky = Sky::new(spec, position.altitude, position.azimuth, scene.site.ground_reflectance, when.date.day_of_year())
-        .map_err(|e| format!("--sky {sky_name} on {} {}: {e}", when.date, when.time))?;
+    let (position, sky) = sky_at(&scene.site, spec, &when);
+    let sky = sky.map_err(|e| format!("--sky {sky_name} on {} {}: {e}", when.date, when.time))?;
     Ok((position, sky))
 }
 

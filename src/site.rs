@@ -19,6 +19,12 @@ pub struct Site {
     pub temperature: f64,
     /// Reflectance of the ground outside the model.
     pub ground_reflectance: f64,
+    /// Where true north is, in degrees clockwise (seen from above) from the
+    /// canonical +y: the designer turning the building on its site after
+    /// loading. 0 from a scene file, whose `model.north` turns the geometry
+    /// itself. Turning the sun and sky the other way is the same as turning
+    /// the building, and needs no new precomputation.
+    pub north_turn: f64,
 }
 
 impl Site {
@@ -37,6 +43,7 @@ impl Site {
             pressure: Self::DEFAULT_PRESSURE,
             temperature: Self::DEFAULT_TEMPERATURE,
             ground_reflectance: Self::DEFAULT_GROUND_REFLECTANCE,
+            north_turn: 0.0,
         }
     }
 }

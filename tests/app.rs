@@ -180,6 +180,17 @@ fn the_sun_and_sky_follow_the_clock_once_per_change() {
         assert_eq!(state.patch_radiance, state.patches.integrate(&sky));
         assert_eq!(state.patch_radiance.len(), 2305);
     }
+    // Turning north on the site turns the sun (in the model's frame) and the
+    // sky with it; the sun's true position stays.
+    let before = app.world().resource::<SunSky>().sky.sun.unwrap().direction;
+    app.world_mut().resource_mut::<Site>().0.north_turn = 90.0;
+    app.update();
+    assert_eq!(messages(&mut app), 1);
+    let state = app.world().resource::<SunSky>();
+    let after = state.sky.sun.unwrap().direction;
+    let turned = heliodon::glam::DQuat::from_rotation_z(-std::f64::consts::FRAC_PI_2) * before;
+    assert!((after - turned).length() < 1e-9, "{after} vs {turned}");
+    assert_eq!(state.sun, solar_position(&site, &LocalDateTime { date, time: TimeOfDay::from_hours(16.25).unwrap() }));
     // A new sky is one more update, and its light shows.
     app.world_mut().resource_mut::<SkyChoice>().0 = SkySpec::Overcast;
     app.update();

@@ -12,7 +12,6 @@ use heliodon::light::{LightModel, LightSettings};
 use heliodon::panel::PanelCatalog;
 use heliodon::scene::{Scene, load_scene};
 use heliodon::sky::{Sky, SkySpec, integrate_hemisphere};
-use heliodon::sun::solar_position;
 use heliodon::time::{Date, LocalDateTime, TimeOfDay};
 
 fn load(path: &Path) -> Arc<Scene> {
@@ -25,8 +24,7 @@ fn sideroom() -> PathBuf {
 
 fn sky_at(scene: &Scene, spec: &SkySpec, date: &str, time: &str) -> Sky {
     let when = LocalDateTime { date: Date::parse(date).unwrap(), time: TimeOfDay::parse(time).unwrap() };
-    let sun = solar_position(&scene.site, &when);
-    Sky::new(spec, sun.altitude, sun.azimuth, scene.site.ground_reflectance, when.date.day_of_year()).unwrap()
+    heliodon::sky::sky_at(&scene.site, spec, &when).1.unwrap()
 }
 
 #[test]
@@ -58,6 +56,43 @@ fn validation_room_agrees_with_radiance() {
     let p90 = errors[errors.len() * 9 / 10];
     println!("median {:.2}% p90 {:.2}% max {:.2}%", 100.0 * median, 100.0 * p90, 100.0 * errors.last().unwrap());
     assert!(median <= 0.05 && p90 <= 0.10, "median {median} p90 {p90}");
+}
+
+/// Turning north on the site (the designer's live edit, which turns the sun
+/// and sky) lights the room as turning the model in its scene file does.
+#[test]
+fn turning_north_on_the_site_matches_turning_the_model_in_its_file() {
+    let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join("north_turned");
+    std::fs::create_dir_all(&work).unwrap();
+    for f in ["model.obj", "model.mtl"] {
+        std::fs::copy(sideroom().with_file_name(f), work.join(f)).unwrap();
+    }
+    // True north along the model's +x: the south windows now face east.
+    let text = std::fs::read_to_string(sideroom()).unwrap().replace("north = [0.0, 1.0, 0.0]", "north = [1.0, 0.0, 0.0]");
+    std::fs::write(work.join("scene.toml"), text).unwrap();
+    let in_file = load(&work.join("scene.toml"));
+    assert!((in_file.frame.north_angle() - 90.0).abs() < 1e-4);
+    let mut turned = (*load(&sideroom())).clone();
+    turned.site.north_turn = 90.0;
+    let turned = Arc::new(turned);
+    let spec = SkySpec::Clear { turbidity: 2.45 };
+    let solve = |scene: &Arc<Scene>| LightModel::precompute(scene.clone(), LightSettings::default()).unwrap().solve(&sky_at(scene, &spec, "2026-12-21", "09:00"), None).sensors;
+    let (a, b, facing_south) = (solve(&turned), solve(&in_file), solve(&load(&sideroom())));
+    // Direct sun is traced exactly; the rest is Monte Carlo, with samples
+    // that do not turn with the model.
+    let mut differences = Vec::new();
+    let mut largest_change = 0.0f64;
+    for ((a, b), south) in a.iter().zip(&b).zip(&facing_south) {
+        println!("{:14} site-turned {:8.1} file-turned {:8.1} (sun {:8.1} / {:8.1}) unturned {:8.1}", a.name, a.total, b.total, a.direct_sun, b.direct_sun, south.total);
+        assert!((a.direct_sun - b.direct_sun).abs() <= 0.01 * b.direct_sun.max(100.0), "{}: direct sun {} vs {}", a.name, a.direct_sun, b.direct_sun);
+        differences.push((a.total / b.total - 1.0).abs());
+        largest_change = largest_change.max((a.total / south.total - 1.0).abs());
+    }
+    differences.sort_by(f64::total_cmp);
+    let (median, max) = (differences[differences.len() / 2], differences[differences.len() - 1]);
+    println!("site-turned vs file-turned: median {:.2}%, max {:.2}%", 100.0 * median, 100.0 * max);
+    assert!(median <= 0.02 && max <= 0.08, "median {median} max {max}");
+    assert!(largest_change > 0.2, "turning north changed the light by {largest_change}");
 }
 
 fn quick() -> LightSettings {

@@ -29,6 +29,7 @@ fn spa_agrees_with_pvlib_on_80_untuned_cases() {
             pressure: num(4),
             temperature: num(5),
             ground_reflectance: 0.2,
+            north_turn: 0.0,
         };
         let when = LocalDateTime { date: Date::parse(f[6]).unwrap(), time: TimeOfDay::parse(f[7]).unwrap() };
         let sun = solar_position(&site, &when);

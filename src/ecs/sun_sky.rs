@@ -8,8 +8,8 @@ use std::sync::Arc;
 use bevy::prelude::*;
 
 use super::{HeliodonSystems, Site};
-use crate::sky::{Sky, SkyPatches, SkySpec};
-use crate::sun::{SolarPosition, solar_position};
+use crate::sky::{Sky, SkyPatches, SkySpec, sky_at};
+use crate::sun::SolarPosition;
 use crate::time::{Date, LocalDateTime, TimeOfDay};
 
 pub struct SunSkyPlugin;
@@ -104,8 +104,8 @@ fn update_sun_and_sky(
     mut changed: MessageWriter<LightChanged>,
     mut rejected: MessageWriter<SkyRejected>,
 ) {
-    let sun = solar_position(&site, &time.0);
-    let sky = match Sky::new(&choice.0, sun.altitude, sun.azimuth, site.ground_reflectance, time.0.date.day_of_year()) {
+    let (sun, sky) = sky_at(&site, &choice.0, &time.0);
+    let sky = match sky {
         Ok(sky) => sky,
         Err(error) => {
             rejected.write(SkyRejected { message: error.0 });

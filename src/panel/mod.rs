@@ -68,11 +68,83 @@ pub trait PanelModel: Send + Sync + fmt::Debug {
 pub trait PanelType: Send + Sync {
     /// The name scene files give as `panel = "..."`.
     fn name(&self) -> &str;
-    /// The keys this panel takes, for error messages and the UI.
-    fn keys(&self) -> &[&str];
+    /// The keys this panel takes: they check scene files (any other key is
+    /// refused) and give the designer's UI one widget each.
+    fn keys(&self) -> &[Key];
     /// A model from a material's keys; a bad or missing key is an error
     /// naming it.
     fn build(&self, parameters: &Parameters) -> Result<Arc<dyn PanelModel>, ParameterError>;
+}
+
+/// One key a panel takes: its name, what it means and the values it
+/// accepts. The same description checks scene files (through
+/// [`Parameters`]) and gives the designer's UI its widget.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Key {
+    pub name: &'static str,
+    /// What the key means, with its unit, in a few words (the UI's tooltip).
+    pub help: &'static str,
+    /// A material must give it; otherwise the kind's default is used.
+    pub required: bool,
+    pub kind: KeyKind,
+}
+
+/// The values a [`Key`] accepts. `default` is used when an optional key is
+/// absent; for a required key it is only where the UI starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum KeyKind {
+    /// A number within `range`.
+    Number { range: (f64, f64), default: f64 },
+    /// A list of as many numbers as `default` has, each within `range`.
+    Numbers { range: (f64, f64), default: &'static [f64] },
+    /// A whole number within `range`.
+    Count { range: (i64, i64), default: i64 },
+    /// A file, relative to the scene file's folder, with this extension.
+    File { extension: &'static str },
+}
+
+impl Key {
+    /// An optional number.
+    pub const fn number(name: &'static str, help: &'static str, range: (f64, f64), default: f64) -> Self {
+        Self { name, help, required: false, kind: KeyKind::Number { range, default } }
+    }
+
+    /// An optional list of numbers.
+    pub const fn numbers(name: &'static str, help: &'static str, range: (f64, f64), default: &'static [f64]) -> Self {
+        Self { name, help, required: false, kind: KeyKind::Numbers { range, default } }
+    }
+
+    /// An optional whole number.
+    pub const fn count(name: &'static str, help: &'static str, range: (i64, i64), default: i64) -> Self {
+        Self { name, help, required: false, kind: KeyKind::Count { range, default } }
+    }
+
+    /// A file (always required).
+    pub const fn file(name: &'static str, help: &'static str, extension: &'static str) -> Self {
+        Self { name, help, required: true, kind: KeyKind::File { extension } }
+    }
+
+    /// The same key, required.
+    pub const fn required(self) -> Self {
+        Self { required: true, ..self }
+    }
+
+    /// The value the key stands for when a material does not give it
+    /// (what the UI starts from), as it would be written in a scene file.
+    pub fn default_value(&self) -> Option<toml::Value> {
+        match self.kind {
+            KeyKind::Number { default, .. } => Some(toml::Value::Float(default)),
+            KeyKind::Numbers { default, .. } => Some(toml::Value::Array(default.iter().map(|v| toml::Value::Float(*v)).collect())),
+            KeyKind::Count { default, .. } => Some(toml::Value::Integer(default)),
+            KeyKind::File { .. } => None,
+        }
+    }
+}
+
+/// Every key at its default (files left out): where the UI starts when a
+/// window is switched to a panel.
+pub fn default_values(keys: &[Key]) -> toml::Table {
+    keys.iter().filter_map(|k| Some((k.name.to_string(), k.default_value()?))).collect()
 }
 
 /// A problem with one of a panel's keys.
@@ -120,54 +192,70 @@ impl Parameters {
         if (lo..=hi).contains(&v) { Ok(v) } else { Err(ParameterError::new(key, format!("{v} is outside {lo}..{hi}"))) }
     }
 
-    /// A number within `range`; `default` when absent (`None`: required).
-    pub fn number(&self, key: &str, default: Option<f64>, range: (f64, f64)) -> Result<f64, ParameterError> {
-        match (self.values.get(key), default) {
-            (Some(value), _) => Self::check_range(key, Self::as_number(key, value)?, range),
-            (None, Some(default)) => Ok(default),
-            (None, None) => Err(ParameterError::new(key, "is required")),
+    /// The value of `key`, or `None` when it is absent and optional (its
+    /// default applies).
+    fn given(&self, key: &Key) -> Result<Option<&toml::Value>, ParameterError> {
+        match self.values.get(key.name) {
+            None if key.required => Err(ParameterError::new(key.name, "is required")),
+            value => Ok(value),
         }
     }
 
-    /// Exactly `N` numbers, each within `range`.
-    pub fn numbers<const N: usize>(&self, key: &str, default: Option<[f64; N]>, range: (f64, f64)) -> Result<[f64; N], ParameterError> {
-        let Some(value) = self.values.get(key) else {
-            return default.ok_or_else(|| ParameterError::new(key, "is required"));
+    /// A panel asked for a key as a kind it did not declare: the panel's bug,
+    /// reported as an error on the key rather than a panic.
+    fn undeclared(key: &Key, kind: &str) -> ParameterError {
+        ParameterError::new(key.name, format!("is not declared as {kind} by its panel ({:?})", key.kind))
+    }
+
+    /// A [`KeyKind::Number`] key.
+    pub fn number(&self, key: &Key) -> Result<f64, ParameterError> {
+        let KeyKind::Number { range, default } = key.kind else { return Err(Self::undeclared(key, "a number")) };
+        match self.given(key)? {
+            Some(value) => Self::check_range(key.name, Self::as_number(key.name, value)?, range),
+            None => Ok(default),
+        }
+    }
+
+    /// A [`KeyKind::Numbers`] key of `N` numbers.
+    pub fn numbers<const N: usize>(&self, key: &Key) -> Result<[f64; N], ParameterError> {
+        let KeyKind::Numbers { range, default } = key.kind else { return Err(Self::undeclared(key, "a list of numbers")) };
+        let Some(value) = self.given(key)? else {
+            return default.try_into().map_err(|_| Self::undeclared(key, &format!("a list of {N} numbers")));
         };
-        let toml::Value::Array(items) = value else { return Err(ParameterError::new(key, format!("must be a list of {N} numbers"))) };
+        let toml::Value::Array(items) = value else { return Err(ParameterError::new(key.name, format!("must be a list of {N} numbers"))) };
         if items.len() != N {
-            return Err(ParameterError::new(key, format!("must be a list of {N} numbers, not {}", items.len())));
+            return Err(ParameterError::new(key.name, format!("must be a list of {N} numbers, not {}", items.len())));
         }
         let mut out = [0.0; N];
         for (slot, item) in out.iter_mut().zip(items) {
-            *slot = Self::check_range(key, Self::as_number(key, item)?, range)?;
+            *slot = Self::check_range(key.name, Self::as_number(key.name, item)?, range)?;
         }
         Ok(out)
     }
 
-    /// A whole number within `range`.
-    pub fn count(&self, key: &str, default: Option<i64>, range: (i64, i64)) -> Result<i64, ParameterError> {
-        match (self.values.get(key), default) {
-            (Some(toml::Value::Integer(i)), _) if (range.0..=range.1).contains(i) => Ok(*i),
-            (Some(toml::Value::Integer(i)), _) => Err(ParameterError::new(key, format!("{i} is outside {}..{}", range.0, range.1))),
-            (Some(_), _) => Err(ParameterError::new(key, "must be a whole number")),
-            (None, Some(default)) => Ok(default),
-            (None, None) => Err(ParameterError::new(key, "is required")),
+    /// A [`KeyKind::Count`] key.
+    pub fn count(&self, key: &Key) -> Result<i64, ParameterError> {
+        let KeyKind::Count { range, default } = key.kind else { return Err(Self::undeclared(key, "a whole number")) };
+        match self.given(key)? {
+            Some(toml::Value::Integer(i)) if (range.0..=range.1).contains(i) => Ok(*i),
+            Some(toml::Value::Integer(i)) => Err(ParameterError::new(key.name, format!("{i} is outside {}..{}", range.0, range.1))),
+            Some(_) => Err(ParameterError::new(key.name, "must be a whole number")),
+            None => Ok(default),
         }
     }
 
-    /// A file path, relative to the scene file's folder.
-    pub fn path(&self, key: &str) -> Result<PathBuf, ParameterError> {
-        match self.values.get(key) {
+    /// A [`KeyKind::File`] key, resolved against the scene file's folder.
+    pub fn path(&self, key: &Key) -> Result<PathBuf, ParameterError> {
+        let KeyKind::File { .. } = key.kind else { return Err(Self::undeclared(key, "a file")) };
+        match self.given(key)? {
             Some(toml::Value::String(s)) if !s.is_empty() => Ok(self.base_dir.join(s)),
-            Some(_) => Err(ParameterError::new(key, "must be a file name")),
-            None => Err(ParameterError::new(key, "is required")),
+            _ => Err(ParameterError::new(key.name, "must be a file name")),
         }
     }
 
     /// The first key that `panel` does not take.
-    pub fn unknown_key(&self, known: &[&str]) -> Option<&str> {
-        self.values.keys().map(String::as_str).find(|k| !known.contains(k))
+    pub fn unknown_key(&self, known: &[Key]) -> Option<&str> {
+        self.values.keys().map(String::as_str).find(|k| known.iter().all(|key| key.name != *k))
     }
 }
 
@@ -210,7 +298,7 @@ impl PanelCatalog {
     pub fn build(&self, name: &str, parameters: &Parameters) -> Result<Arc<dyn PanelModel>, ParameterError> {
         let panel = self.get(name).ok_or_else(|| ParameterError::new("panel", format!("no panel named '{name}' is registered")))?;
         if let Some(key) = parameters.unknown_key(panel.keys()) {
-            return Err(ParameterError::new(key, format!("is not a key of panel '{name}' (its keys: {})", panel.keys().join(", "))));
+            return Err(ParameterError::new(key, format!("is not a key of panel '{name}' (its keys: {})", panel.keys().iter().map(|k| k.name).collect::<Vec<_>>().join(", "))));
         }
         panel.build(parameters)
     }
@@ -287,17 +375,26 @@ mod tests {
 
     #[test]
     fn parameters_are_checked_by_key() {
+        const A: Key = Key::number("a", "", (1.0, 2.0), 1.2);
+        const A_HIGH: Key = Key::number("a", "", (2.0, 3.0), 2.5);
+        const MISSING: Key = Key::number("missing", "", (0.0, 5.0), 4.0);
+        const B: Key = Key::numbers("b", "", (0.0, 3.0), &[1.0, 1.0]);
+        const C: Key = Key::file("c", "", "xml");
+        const N: Key = Key::count("n", "", (1, 5), 2);
         let values: toml::Table = toml::from_str("a = 1.5\nb = [1.0, 2.0]\nc = \"x\"\nn = 3").unwrap();
         let p = Parameters::new(values, "/scenes");
-        assert_eq!(p.number("a", None, (1.0, 2.0)), Ok(1.5));
-        assert_eq!(p.number("a", None, (2.0, 3.0)).unwrap_err().key, "a");
-        assert_eq!(p.number("missing", Some(4.0), (0.0, 5.0)), Ok(4.0));
-        assert!(p.number("missing", None, (0.0, 5.0)).unwrap_err().message.contains("required"));
-        assert_eq!(p.numbers::<2>("b", None, (0.0, 3.0)), Ok([1.0, 2.0]));
-        assert!(p.numbers::<3>("b", None, (0.0, 3.0)).is_err());
-        assert!(p.number("c", None, (0.0, 1.0)).unwrap_err().message.contains("number"));
-        assert_eq!(p.path("c"), Ok(PathBuf::from("/scenes/x")));
-        assert_eq!(p.count("n", None, (1, 5)), Ok(3));
-        assert_eq!(p.unknown_key(&["a", "b", "c"]), Some("n"));
+        assert_eq!(p.number(&A), Ok(1.5));
+        assert_eq!(p.number(&A_HIGH).unwrap_err().key, "a");
+        assert_eq!(p.number(&MISSING), Ok(4.0));
+        assert!(p.number(&MISSING.required()).unwrap_err().message.contains("required"));
+        assert_eq!(p.numbers::<2>(&B), Ok([1.0, 2.0]));
+        assert!(p.numbers::<3>(&B).is_err());
+        assert!(p.number(&Key::number("c", "", (0.0, 1.0), 0.5)).unwrap_err().message.contains("number"));
+        assert_eq!(p.path(&C), Ok(PathBuf::from("/scenes/x")));
+        assert_eq!(p.count(&N), Ok(3));
+        // Asking for a key as a kind it was not declared as is an error, not a panic.
+        assert!(p.count(&A).unwrap_err().message.contains("not declared"));
+        assert_eq!(p.unknown_key(&[A, B, C]), Some("n"));
+        assert_eq!(B.default_value(), Some(toml::Value::Array(vec![1.0.into(), 1.0.into()])));
     }
 }

@@ -14,8 +14,7 @@ use super::RenderMode;
 use crate::ecs::panel_catalog;
 use crate::light::LightModel;
 use crate::scene::{MaterialKind, Viewpoint, load_scene};
-use crate::sky::{LUMINOUS_EFFICACY, Sky};
-use crate::sun::solar_position;
+use crate::sky::{LUMINOUS_EFFICACY, sky_at};
 
 /// Pixel centres' rays of a perspective camera as Bevy draws it (vertical
 /// field of view, the model's z up), row by row from the top.
@@ -74,8 +73,7 @@ pub fn compare_direct_sun(request: &OffscreenRequest, picture: &Path) -> Result<
     let model = LightModel::unlit(scene.clone());
     let when = request.when.ok_or("the comparison needs a time")?;
     let spec = request.sky.clone().ok_or("the comparison needs a sky")?;
-    let position = solar_position(&scene.site, &when);
-    let sky = Sky::new(&spec, position.altitude, position.azimuth, scene.site.ground_reflectance, when.date.day_of_year()).map_err(|e| e.to_string())?;
+    let sky = sky_at(&scene.site, &spec, &when).1.map_err(|e| e.to_string())?;
     let sun = sky.sun.filter(|s| s.direction.z > 0.0).ok_or("the sun is down")?;
     let view = request.view.clone().unwrap_or_else(|| super::initial_view(&scene));
     let image = offscreen::render(request.clone())?;

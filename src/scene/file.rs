@@ -198,6 +198,7 @@ fn site(parsed: &ParsedScene, table: &SiteTable) -> Result<Site, SceneError> {
         elevation: optional(&table.elevation, "site.elevation", (-500.0, 9000.0), Site::DEFAULT_ELEVATION)?,
         pressure: optional(&table.pressure, "site.pressure", (300.0, 1200.0), Site::DEFAULT_PRESSURE)?,
         temperature: optional(&table.temperature, "site.temperature", (-90.0, 60.0), Site::DEFAULT_TEMPERATURE)?,
+        north_turn: 0.0,
     })
 }
 

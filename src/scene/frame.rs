@@ -81,6 +81,13 @@ impl ModelFrame {
         Ok(Self { up, north, scale, rotation })
     }
 
+    /// Where the scene file puts true north: degrees clockwise (seen from
+    /// above) from the model's default north.
+    pub fn north_angle(&self) -> f64 {
+        let level = self.up.to_z_up() * self.north;
+        f64::from(level.x.atan2(level.y).to_degrees())
+    }
+
     /// A model-space point in canonical coordinates.
     pub fn point(&self, p: Vec3) -> Vec3 {
         self.rotation * (p * self.scale)

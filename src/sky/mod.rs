@@ -16,6 +16,10 @@ use std::fmt;
 
 use glam::DVec3;
 
+use crate::site::Site;
+use crate::sun::{SolarPosition, solar_position};
+use crate::time::LocalDateTime;
+
 pub use export::radiance_sky;
 pub use patches::SkyPatches;
 
@@ -369,6 +373,16 @@ impl Sky {
             _ => None,
         }
     }
+}
+
+/// The sun at a site and local time (its true angles), and the sky it makes
+/// in the model's frame: turned by the site's `north_turn`. Every sky
+/// distribution depends only on the angle to the sun and the zenith, so
+/// moving the sun's azimuth turns the whole sky.
+pub fn sky_at(site: &Site, spec: &SkySpec, when: &LocalDateTime) -> (SolarPosition, Result<Sky, SkyError>) {
+    let sun = solar_position(site, when);
+    let sky = Sky::new(spec, sun.altitude, sun.azimuth + site.north_turn, site.ground_reflectance, when.date.day_of_year());
+    (sun, sky)
 }
 
 /// ∫ f dω and ∫ f·cos θ dω over the upper hemisphere, by the midpoint rule

@@ -6,6 +6,7 @@
 
 pub mod camera;
 pub mod lobes;
+pub mod materials;
 pub mod sensors;
 pub mod ui;
 

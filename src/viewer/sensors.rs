@@ -12,8 +12,7 @@ use bevy::tasks::{AsyncComputeTaskPool, Task, block_on, futures_lite::future};
 
 use crate::ecs::{LightEngine, LightingState, Site, SkyChoice, SolarTime};
 use crate::light::LightModel;
-use crate::sky::{Sky, SkySpec};
-use crate::sun::solar_position;
+use crate::sky::{SkySpec, sky_at};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
 
 /// The sensor the panels and the plot follow.
@@ -217,8 +216,7 @@ pub fn day_series(model: &Arc<LightModel>, sensor: usize, site: &crate::site::Si
     (0..DAY_STEPS)
         .map(|k| {
             let time = TimeOfDay::from_hours((k as f64 + 0.5) * 24.0 / DAY_STEPS as f64).expect("a time of day");
-            let position = solar_position(site, &LocalDateTime { date, time });
-            let Ok(sky) = Sky::new(spec, position.altitude, position.azimuth, site.ground_reflectance, date.day_of_year()) else { return 0.0 };
+            let Ok(sky) = sky_at(site, spec, &LocalDateTime { date, time }).1 else { return 0.0 };
             let lighting = model.solve(&sky, previous.as_ref());
             let value = lighting.sensors.get(sensor).map_or(0.0, |r| r.total);
             previous = Some(lighting);

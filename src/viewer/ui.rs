@@ -1,10 +1,11 @@
 //! [`DesignerUiPlugin`]: the designer's panels (bevy_egui). Left: the sun
-//! and sky (date, time, play, site with a sun-path diagram, sky type and
-//! parameters, exposure). Right: the camera (presets, viewpoints, walk
+//! and sky (date, time, play, site and north with a sun-path diagram, sky
+//! type and parameters, exposure), then the windows and materials
+//! ([`super::materials`]). Right: the camera (presets, viewpoints, walk
 //! mode), the view (modes, the light's progress, saving the image) and the
-//! sensors (live table, the selected one's day, CSV export). The 3D view fills the space between them:
-//! the camera's viewport follows the panels, and the pointer over a panel
-//! belongs to the panel.
+//! sensors (live table, the selected one's day and year, CSV export). The 3D
+//! view fills the space between them: the camera's viewport follows the
+//! panels, and the pointer over a panel belongs to the panel.
 
 use bevy::camera::visibility::RenderLayers;
 use bevy::camera::{CameraOutputMode, Viewport};
@@ -18,9 +19,8 @@ use bevy::ecs::system::SystemParam;
 
 use super::camera::CadCamera;
 use super::sensors::{DAY_STEPS, DaySeries, SelectedSensor, YEAR_DAYS, YearMap};
-use crate::ecs::{ActiveScene, EditMaterial, LightEngine, LightingState, MaterialEditRejected, PanelRegistry, Site, SkyChoice, SolarTime, SunSky};
-use crate::panel::Parameters;
-use crate::scene::{MaterialKind, Rgb};
+use super::materials::{MaterialEdits, MaterialPanel, material_panel};
+use crate::ecs::{ActiveScene, LightEngine, LightingState, Site, SkyChoice, SolarTime, SunSky};
 use crate::scene::Viewpoint;
 use crate::render::{RenderMode, RenderSettings};
 use crate::sky::perez;
@@ -70,8 +70,8 @@ pub struct UiState {
     pub camera_request: Option<CameraRequest>,
     /// Save the window as a PNG (in the working folder).
     pub save_image: bool,
-    /// Panel materials' keys being edited (TOML), by material index.
-    pub panel_text: std::collections::HashMap<u32, String>,
+    /// What the materials panel is editing.
+    pub materials: MaterialEdits,
 }
 
 /// The camera changes the panel offers.
@@ -133,14 +133,6 @@ pub struct SensorPanel<'w> {
     active: Res<'w, ActiveScene>,
 }
 
-/// What the materials part of the panel needs.
-#[derive(SystemParam)]
-pub struct MaterialPanel<'w, 's> {
-    registry: Option<Res<'w, PanelRegistry>>,
-    edits: MessageWriter<'w, EditMaterial>,
-    rejected: MessageReader<'w, 's, MaterialEditRejected>,
-}
-
 #[allow(clippy::too_many_arguments)]
 fn panels(
     mut contexts: EguiContexts,
@@ -161,9 +153,13 @@ fn panels(
         .default_size(270.0)
         .show(&mut root, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
-                sun_and_sky_panel(ui, &mut ui_state, &mut solar, &mut sky, &mut settings, site, sun_sky.as_deref());
+                let north_turn = site.as_ref().map_or(0.0, |s| s.north_turn);
+                sun_and_sky_panel(ui, &mut ui_state, &mut solar, &mut sky, &mut settings, site, sun_sky.as_deref(), sensors.active.scene.as_deref());
                 ui.separator();
-                material_panel(ui, &mut ui_state, &sensors.active, &mut materials);
+                if let Some(scene) = &sensors.active.scene {
+                    let UiState { materials: edits, note, .. } = &mut *ui_state;
+                    material_panel(ui, edits, note, scene, north_turn, &mut materials);
+                }
             });
         })
         .response
@@ -208,6 +204,7 @@ fn sun_and_sky_panel(
     settings: &mut ResMut<RenderSettings>,
     site: Option<ResMut<Site>>,
     sun_sky: Option<&SunSky>,
+    scene: Option<&crate::scene::Scene>,
 ) {
     ui.heading("Sun and sky");
     let LocalDateTime { mut date, time } = solar.0;
@@ -277,7 +274,17 @@ fn sun_and_sky_panel(
             bounded(ui, &mut s.latitude, -90.0..=90.0, 0.1, "lat ", "", &mut state.note);
             bounded(ui, &mut s.longitude, -180.0..=180.0, 0.1, "lon ", "", &mut state.note);
         });
-        bounded(ui, &mut s.timezone, -14.0..=14.0, 0.25, "UTC ", "", &mut state.note);
+        // North as the designer sees it: from the model's own default north,
+        // the scene file's turn included.
+        let from_file = scene.map_or(0.0, |scene| scene.frame.north_angle());
+        ui.horizontal(|ui| {
+            bounded(ui, &mut s.timezone, -14.0..=14.0, 0.25, "UTC ", "", &mut state.note);
+            let mut north = from_file + s.north_turn;
+            bounded(ui, &mut north, -360.0..=360.0, 0.5, "north ", "°", &mut state.note).on_hover_text("true north, clockwise from the model's north axis");
+            if north != from_file + s.north_turn {
+                s.north_turn = north - from_file;
+            }
+        });
         if s != site.0 {
             site.0 = s;
         }
@@ -303,7 +310,7 @@ fn sun_and_sky_panel(
 
 /// A number field: what is typed outside `range` is clamped into it, with a
 /// note saying so (never a panic, never a silent change).
-fn bounded(ui: &mut Ui, value: &mut f64, range: std::ops::RangeInclusive<f64>, speed: f64, prefix: &str, suffix: &str, note: &mut Option<String>) -> egui::Response {
+pub(super) fn bounded(ui: &mut Ui, value: &mut f64, range: std::ops::RangeInclusive<f64>, speed: f64, prefix: &str, suffix: &str, note: &mut Option<String>) -> egui::Response {
     let response = ui.add(egui::DragValue::new(value).speed(speed).prefix(prefix).suffix(suffix));
     if !range.contains(value) {
         let clamped = if value.is_nan() { *range.start() } else { value.clamp(*range.start(), *range.end()) };
@@ -425,91 +432,6 @@ fn view_panel(ui: &mut Ui, state: &mut UiState, settings: &mut ResMut<RenderSett
     if ui.button("Save image (PNG)").clicked() {
         state.save_image = true;
     }
-}
-
-/// Every material: diffuse reflectances, and for windows glass (with its
-/// transmittance) or a registered panel (with its keys, as in the scene
-/// file). Each change relights; a panel whose keys do not build keeps the
-/// material it had and says why.
-fn material_panel(ui: &mut Ui, state: &mut UiState, active: &ActiveScene, panel: &mut MaterialPanel) {
-    for rejected in panel.rejected.read() {
-        state.note = Some(rejected.message.clone());
-    }
-    let Some(scene) = &active.scene else { return };
-    egui::CollapsingHeader::new("Materials").default_open(true).show(ui, |ui| {
-        let catalog = panel.registry.as_ref().map(|r| r.catalog()).unwrap_or_default();
-        let base = crate::panel::base_dir(&scene.files.scene);
-        for (index, material) in scene.materials.iter().enumerate() {
-            let index = index as u32;
-            ui.label(egui::RichText::new(&material.name).strong());
-            match &material.kind {
-                MaterialKind::Diffuse { reflectance } => {
-                    let mut rgb = reflectance.0;
-                    let response = ui.horizontal(|ui| {
-                        let mut changed = false;
-                        for (c, label) in ["R", "G", "B"].iter().enumerate() {
-                            let r = ui.add(egui::DragValue::new(&mut rgb[c]).range(0.0..=1.0).speed(0.005).prefix(*label));
-                            changed |= r.drag_stopped() || (r.changed() && !r.dragged());
-                        }
-                        changed
-                    });
-                    if response.inner {
-                        panel.edits.write(EditMaterial { index, kind: MaterialKind::Diffuse { reflectance: Rgb(rgb) } });
-                    }
-                }
-                MaterialKind::Glass { .. } | MaterialKind::Panel { .. } => {
-                    let current = match &material.kind {
-                        MaterialKind::Panel { panel, .. } => panel.clone(),
-                        _ => "glass".to_string(),
-                    };
-                    let mut chosen = current.clone();
-                    egui::ComboBox::from_id_salt(("window_material", index)).selected_text(&chosen).show_ui(ui, |ui| {
-                        ui.selectable_value(&mut chosen, "glass".to_string(), "glass");
-                        for name in catalog.names() {
-                            ui.selectable_value(&mut chosen, name.to_string(), name);
-                        }
-                    });
-                    if let MaterialKind::Glass { transmittance } = &material.kind
-                        && chosen == "glass"
-                    {
-                        let mut t = *transmittance;
-                        let r = ui.add(egui::Slider::new(&mut t, 0.0..=1.0).text("transmittance"));
-                        if r.drag_stopped() || (r.changed() && !r.dragged()) {
-                            panel.edits.write(EditMaterial { index, kind: MaterialKind::Glass { transmittance: t } });
-                        }
-                    }
-                    let text = state.panel_text.entry(index).or_insert_with(|| match &material.kind {
-                        MaterialKind::Panel { parameters, .. } => toml::to_string(parameters).unwrap_or_default(),
-                        _ => String::new(),
-                    });
-                    if chosen == "glass" && current != "glass" {
-                        panel.edits.write(EditMaterial { index, kind: MaterialKind::Glass { transmittance: 0.88 } });
-                    } else if chosen != "glass" {
-                        ui.add(egui::TextEdit::multiline(text).desired_rows(3).code_editor());
-                        if ui.button("Apply").clicked() || chosen != current {
-                            let parameters = Parameters::from_toml(text, base.clone());
-                            let built = parameters.map_err(|e| format!("{}: {e}", material.name)).and_then(|p| {
-                                let model = catalog.build(&chosen, &p).map_err(|e| format!("{}: {}: {}", material.name, e.key, e.message))?;
-                                let up = match &material.kind {
-                                    MaterialKind::Panel { up, .. } => *up,
-                                    _ => None,
-                                };
-                                Ok(MaterialKind::Panel { panel: chosen.clone(), up, parameters: p.values, model: crate::panel::PanelHandle(model) })
-                            });
-                            match built {
-                                Ok(kind) => {
-                                    state.note = None;
-                                    panel.edits.write(EditMaterial { index, kind });
-                                }
-                                // The material keeps what it had.
-                                Err(message) => state.note = Some(message),
-                            }
-                        }
-                    }
-                }
-            }
-        }
-    });
 }
 
 /// Camera presets, the scene's and the user's viewpoints, walk mode.

@@ -25,7 +25,7 @@ use std::sync::Arc;
 use heliodon::bevy::prelude::{App, Plugin};
 use heliodon::ecs::RegisterPanel;
 use heliodon::glam::DVec3;
-use heliodon::panel::{Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters};
+use heliodon::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters};
 use spade::{DelaunayTriangulation, FloatTriangulation, Point2, Triangulation};
 
 use xml::{Basis, BsdfFile};
@@ -39,6 +39,10 @@ impl Plugin for BsdfPlugin {
     }
 }
 
+const FILE: Key = Key::file("file", "WINDOW6 BSDF XML (Klems basis)", "xml");
+const LOBES: Key = Key::count("lobes", "specular lobes fitted per direction", (1, 8), 3);
+const LOBE_WIDTH: Key = Key::number("lobe_width", "full angle of the cone each lobe takes (°)", (1.0, 90.0), 23.0);
+
 /// The `bsdf` panel type.
 pub struct Bsdf;
 
@@ -47,14 +51,14 @@ impl PanelType for Bsdf {
         "bsdf"
     }
 
-    fn keys(&self) -> &[&str] {
-        &["file", "lobes", "lobe_width"]
+    fn keys(&self) -> &[Key] {
+        &[FILE, LOBES, LOBE_WIDTH]
     }
 
     fn build(&self, parameters: &Parameters) -> Result<Arc<dyn PanelModel>, ParameterError> {
-        let path = parameters.path("file")?;
-        let lobes = parameters.count("lobes", Some(3), (1, 8))? as usize;
-        let width = parameters.number("lobe_width", Some(23.0), (1.0, 90.0))?;
+        let path = parameters.path(&FILE)?;
+        let lobes = parameters.count(&LOBES)? as usize;
+        let width = parameters.number(&LOBE_WIDTH)?;
         let text = std::fs::read_to_string(&path).map_err(|e| ParameterError::new("file", format!("cannot read {}: {e}", path.display())))?;
         let file = xml::parse(&text, &path).map_err(|e| ParameterError::new("file", e))?;
         Ok(Arc::new(BsdfModel::fit(&file, lobes, width)))

@@ -18,7 +18,7 @@ use std::sync::Arc;
 use heliodon::bevy::prelude::{App, Plugin};
 use heliodon::ecs::RegisterPanel;
 use heliodon::glam::DVec3;
-use heliodon::panel::{Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters, fresnel_reflectance, reflect, refract};
+use heliodon::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters, fresnel_reflectance, reflect, refract};
 
 /// Registers the `laser_cut` panel.
 pub struct LaserCutPlugin;
@@ -37,17 +37,21 @@ impl PanelType for LaserCut {
         "laser_cut"
     }
 
-    fn keys(&self) -> &[&str] {
-        &["cut_spacing_ratio", "cut_angle", "refractive_index"]
+    fn keys(&self) -> &[Key] {
+        &[CUT_SPACING_RATIO, CUT_ANGLE, REFRACTIVE_INDEX]
     }
 
     fn build(&self, parameters: &Parameters) -> Result<Arc<dyn PanelModel>, ParameterError> {
-        let ratio = parameters.number("cut_spacing_ratio", None, (0.05, 10.0))?;
-        let angle = parameters.number("cut_angle", Some(0.0), (-60.0, 60.0))?;
-        let index = parameters.number("refractive_index", Some(1.49), (1.0, 3.0))?;
+        let ratio = parameters.number(&CUT_SPACING_RATIO)?;
+        let angle = parameters.number(&CUT_ANGLE)?;
+        let index = parameters.number(&REFRACTIVE_INDEX)?;
         Ok(Arc::new(LaserCutModel { ratio, angle: angle.to_radians(), index }))
     }
 }
+
+const CUT_SPACING_RATIO: Key = Key::number("cut_spacing_ratio", "cut spacing over sheet thickness, D/W", (0.05, 10.0), 0.5).required();
+const CUT_ANGLE: Key = Key::number("cut_angle", "tilt of the cuts from perpendicular to the sheet (°)", (-60.0, 60.0), 0.0);
+const REFRACTIVE_INDEX: Key = Key::number("refractive_index", "of the sheet (acrylic 1.49)", (1.0, 3.0), 1.49);
 
 /// Nominal angular width of a lobe (degrees).
 const LOBE_WIDTH: f64 = 3.0;
@@ -181,6 +185,7 @@ mod tests {
     fn keys_are_checked() {
         let build = |text: &str| LaserCut.build(&Parameters::from_toml(text, "").unwrap());
         assert!(build("cut_spacing_ratio = 0.5").is_ok());
+        assert!(LaserCut.build(&Parameters::new(heliodon::panel::default_values(LaserCut.keys()), "")).is_ok());
         assert_eq!(build("").unwrap_err().key, "cut_spacing_ratio");
         assert_eq!(build("cut_spacing_ratio = 0.5\ncut_angle = 80.0").unwrap_err().key, "cut_angle");
     }

@@ -19,7 +19,7 @@ use std::sync::Arc;
 use heliodon::bevy::prelude::{App, Plugin};
 use heliodon::ecs::RegisterPanel;
 use heliodon::glam::DVec3;
-use heliodon::panel::{Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters, fresnel_reflectance, reflect, refract};
+use heliodon::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters, fresnel_reflectance, reflect, refract};
 
 /// Registers the `prismatic` panel.
 pub struct PrismaticPlugin;
@@ -38,19 +38,23 @@ impl PanelType for Prismatic {
         "prismatic"
     }
 
-    fn keys(&self) -> &[&str] {
-        &["facet_angles", "refractive_index"]
+    fn keys(&self) -> &[Key] {
+        &[FACET_ANGLES, REFRACTIVE_INDEX]
     }
 
     fn build(&self, parameters: &Parameters) -> Result<Arc<dyn PanelModel>, ParameterError> {
-        let [a, b] = parameters.numbers("facet_angles", None, (0.0, 89.0))?;
+        let [a, b] = parameters.numbers(&FACET_ANGLES)?;
         if a + b <= 0.0 {
             return Err(ParameterError::new("facet_angles", "at least one facet must be tilted"));
         }
-        let index = parameters.number("refractive_index", Some(1.49), (1.0, 3.0))?;
+        let index = parameters.number(&REFRACTIVE_INDEX)?;
         Ok(Arc::new(PrismaticModel::new([a, b], index)))
     }
 }
+
+const FACET_ANGLES: Key =
+    Key::numbers("facet_angles", "tilt from the panel plane of the upward and the downward facet (°)", (0.0, 89.0), &[40.0, 5.0]).required();
+const REFRACTIVE_INDEX: Key = Key::number("refractive_index", "of the sheet (acrylic 1.49)", (1.0, 3.0), 1.49);
 
 /// Paths are followed through at most this many interactions; what is
 /// left then is light guided inside the sheet to its edges (absorbed).
@@ -235,6 +239,7 @@ mod tests {
     fn keys_are_checked() {
         let build = |text: &str| Prismatic.build(&Parameters::from_toml(text, "").unwrap());
         assert!(build("facet_angles = [40.0, 5.0]").is_ok());
+        assert!(Prismatic.build(&Parameters::new(heliodon::panel::default_values(Prismatic.keys()), "")).is_ok());
         assert_eq!(build("").unwrap_err().key, "facet_angles");
         assert_eq!(build("facet_angles = [40.0, 95.0]").unwrap_err().key, "facet_angles");
         assert_eq!(build("facet_angles = [40.0, 5.0]\nrefractive_index = 0.5").unwrap_err().key, "refractive_index");

@@ -17,7 +17,7 @@ use std::sync::Arc;
 use heliodon::bevy::prelude::{App, Plugin};
 use heliodon::ecs::RegisterPanel;
 use heliodon::glam::DVec3;
-use heliodon::panel::{Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters, reflect};
+use heliodon::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters, reflect};
 
 /// Registers the `venetian` panel.
 pub struct VenetianPlugin;
@@ -36,22 +36,28 @@ impl PanelType for Venetian {
         "venetian"
     }
 
-    fn keys(&self) -> &[&str] {
-        &["slat_width", "slat_spacing", "tilt", "specular", "diffuse"]
+    fn keys(&self) -> &[Key] {
+        &[SLAT_WIDTH, SLAT_SPACING, TILT, SPECULAR, DIFFUSE]
     }
 
     fn build(&self, parameters: &Parameters) -> Result<Arc<dyn PanelModel>, ParameterError> {
-        let width = parameters.number("slat_width", None, (1e-3, 1.0))?;
-        let spacing = parameters.number("slat_spacing", None, (1e-3, 1.0))?;
-        let tilt = parameters.number("tilt", Some(0.0), (-89.0, 89.0))?;
-        let specular = parameters.number("specular", None, (0.0, 1.0))?;
-        let diffuse = parameters.number("diffuse", None, (0.0, 1.0))?;
+        let width = parameters.number(&SLAT_WIDTH)?;
+        let spacing = parameters.number(&SLAT_SPACING)?;
+        let tilt = parameters.number(&TILT)?;
+        let specular = parameters.number(&SPECULAR)?;
+        let diffuse = parameters.number(&DIFFUSE)?;
         if specular + diffuse > 1.0 {
             return Err(ParameterError::new("diffuse", format!("specular + diffuse = {} is more than 1", specular + diffuse)));
         }
         Ok(Arc::new(VenetianModel { width, spacing, tilt: tilt.to_radians(), specular, diffuse }))
     }
 }
+
+const SLAT_WIDTH: Key = Key::number("slat_width", "slat depth across the window (m)", (1e-3, 1.0), 0.025).required();
+const SLAT_SPACING: Key = Key::number("slat_spacing", "vertical distance between slats (m)", (1e-3, 1.0), 0.0225).required();
+const TILT: Key = Key::number("tilt", "slat tilt from horizontal (°)", (-89.0, 89.0), 0.0);
+const SPECULAR: Key = Key::number("specular", "mirror reflectance of the slats", (0.0, 1.0), 0.9).required();
+const DIFFUSE: Key = Key::number("diffuse", "diffuse reflectance of the slats", (0.0, 1.0), 0.05).required();
 
 /// Rays traced through one period (evenly spaced: shares come in steps of 1/128).
 const RAYS: usize = 128;
@@ -221,6 +227,7 @@ mod tests {
         let build = |text: &str| Venetian.build(&Parameters::from_toml(text, "").unwrap());
         let ok = "slat_width = 0.025\nslat_spacing = 0.0225\ntilt = 30.0\nspecular = 0.9\ndiffuse = 0.05";
         assert!(build(ok).is_ok());
+        assert!(Venetian.build(&Parameters::new(heliodon::panel::default_values(Venetian.keys()), "")).is_ok());
         assert_eq!(build(&ok.replace("diffuse = 0.05", "diffuse = 0.5")).unwrap_err().key, "diffuse");
         assert_eq!(build(&ok.replace("tilt = 30.0", "tilt = 95.0")).unwrap_err().key, "tilt");
         assert_eq!(build("tilt = 1.0").unwrap_err().key, "slat_width");

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use heliodon::bevy::prelude::{App, Plugin};
 use heliodon::ecs::RegisterPanel;
 use heliodon::glam::DVec3;
-use heliodon::panel::{Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters};
+use heliodon::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters};
 
 pub struct GreyFilterPlugin;
 
@@ -19,17 +19,19 @@ impl Plugin for GreyFilterPlugin {
 
 pub struct GreyFilter;
 
+const TRANSMITTANCE: Key = Key::number("transmittance", "share passed straight through", (0.0, 1.0), 0.5).required();
+
 impl PanelType for GreyFilter {
     fn name(&self) -> &str {
         "grey_filter"
     }
 
-    fn keys(&self) -> &[&str] {
-        &["transmittance"]
+    fn keys(&self) -> &[Key] {
+        &[TRANSMITTANCE]
     }
 
     fn build(&self, parameters: &Parameters) -> Result<Arc<dyn PanelModel>, ParameterError> {
-        Ok(Arc::new(GreyFilterModel { transmittance: parameters.number("transmittance", None, (0.0, 1.0))? }))
+        Ok(Arc::new(GreyFilterModel { transmittance: parameters.number(&TRANSMITTANCE)? }))
     }
 }
 

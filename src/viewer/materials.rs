@@ -1,0 +1,349 @@
+//! The materials panel: every group of windows (panes of one material
+//! facing one way) with its material, plain glass or any registered panel
+//! with one widget per key the panel declares; and the reflectances of the
+//! opaque materials. Every change sends [`EditMaterial`] (the scene is
+//! respawned and relit); a panel whose keys do not build keeps the material
+//! it had, and the panel says why.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use bevy::ecs::system::SystemParam;
+use bevy::prelude::*;
+use bevy_egui::egui::{self, Ui};
+
+use super::ui::bounded;
+use crate::ecs::{EditMaterial, MaterialEditRejected, PanelRegistry};
+use crate::panel::{Key, KeyKind, PanelCatalog, Parameters, default_values};
+use crate::scene::{MaterialKind, Rgb, Scene};
+
+/// Transmittance a window gets when switched back to plain glass.
+const CLEAR_GLASS: f32 = 0.88;
+/// How deep below the scene's folder (and its two parents) panel data files
+/// are looked for, and how many folder entries at most are read doing so.
+const FILE_SEARCH_DEPTH: usize = 3;
+const FILE_SEARCH_ENTRIES: usize = 5000;
+
+/// What the materials panel keeps between frames.
+#[derive(Debug, Clone, Default)]
+pub struct MaterialEdits {
+    /// Panel keys being edited, by material: what the material had when the
+    /// editing started, and the values in the widgets.
+    pending: HashMap<u32, PendingKeys>,
+    /// Data files offered for file keys, by extension (relative to the scene's folder).
+    files: HashMap<&'static str, Vec<String>>,
+}
+
+#[derive(Debug, Clone)]
+struct PendingKeys {
+    panel: String,
+    applied: toml::Table,
+    values: toml::Table,
+}
+
+/// What the materials panel reads and writes.
+#[derive(SystemParam)]
+pub struct MaterialPanel<'w, 's> {
+    registry: Option<Res<'w, PanelRegistry>>,
+    edits: MessageWriter<'w, EditMaterial>,
+    rejected: MessageReader<'w, 's, MaterialEditRejected>,
+}
+
+/// Windows of one material that face one way.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WindowGroup {
+    pub material: u32,
+    /// Compass point the panes look out to (true north at `north_turn`), or
+    /// "skylight".
+    pub facing: &'static str,
+    pub panes: usize,
+    /// m².
+    pub area: f64,
+}
+
+/// The scene's windows grouped by material and facing, in material order.
+/// A pane looks out away from the model's centre; `north_turn` is where true
+/// north is, in degrees clockwise from +y.
+pub fn window_groups(scene: &Scene, north_turn: f64) -> Vec<WindowGroup> {
+    const COMPASS: [&str; 8] = ["north", "north-east", "east", "south-east", "south", "south-west", "west", "north-west"];
+    let centre = (scene.bounds.0 + scene.bounds.1) * 0.5;
+    let mut groups: Vec<WindowGroup> = Vec::new();
+    for window in &scene.windows {
+        let n = window.normal;
+        let facing = if n.z.abs() > 0.7 {
+            "skylight"
+        } else {
+            let out = (window.centroid - centre).truncate();
+            let h = if n.truncate().dot(out) < 0.0 { -n.truncate() } else { n.truncate() };
+            let azimuth = f64::from(h.x.atan2(h.y).to_degrees()) - north_turn;
+            COMPASS[((azimuth.rem_euclid(360.0) + 22.5) / 45.0) as usize % 8]
+        };
+        match groups.iter_mut().find(|g| g.material == window.material && g.facing == facing) {
+            Some(group) => {
+                group.panes += 1;
+                group.area += f64::from(window.area);
+            }
+            None => groups.push(WindowGroup { material: window.material, facing, panes: 1, area: f64::from(window.area) }),
+        }
+    }
+    groups.sort_by_key(|g| g.material);
+    groups
+}
+
+/// The windows, then the opaque materials.
+pub fn material_panel(ui: &mut Ui, edits: &mut MaterialEdits, note: &mut Option<String>, scene: &Scene, north_turn: f64, panel: &mut MaterialPanel) {
+    for rejected in panel.rejected.read() {
+        *note = Some(rejected.message.clone());
+    }
+    let catalog = panel.registry.as_ref().map(|r| r.catalog()).unwrap_or_default();
+    let base = crate::panel::base_dir(&scene.files.scene);
+    egui::CollapsingHeader::new("Windows").default_open(true).show(ui, |ui| {
+        let groups = window_groups(scene, north_turn);
+        let mut shown = Vec::new();
+        for group in &groups {
+            if shown.contains(&group.material) {
+                continue;
+            }
+            shown.push(group.material);
+            let material = &scene.materials[group.material as usize];
+            for g in groups.iter().filter(|g| g.material == group.material) {
+                ui.label(format!("{} windows: {} panes, {:.1} m²", g.facing, g.panes, g.area));
+            }
+            ui.horizontal(|ui| {
+                ui.label("material");
+                ui.strong(&material.name);
+            });
+            if let Some(kind) = window_material(ui, edits, note, group.material, &material.kind, &catalog, &base) {
+                panel.edits.write(EditMaterial { index: group.material, kind });
+            }
+            ui.separator();
+        }
+    });
+    egui::CollapsingHeader::new("Opaque materials").default_open(false).show(ui, |ui| {
+        for (index, material) in scene.materials.iter().enumerate() {
+            let MaterialKind::Diffuse { reflectance } = &material.kind else { continue };
+            let mut rgb = reflectance.0;
+            let changed = ui
+                .horizontal(|ui| {
+                    ui.label(&material.name);
+                    let mut changed = false;
+                    for (c, label) in ["R ", "G ", "B "].iter().enumerate() {
+                        changed |= committed(&ui.add(egui::DragValue::new(&mut rgb[c]).range(0.0..=1.0).speed(0.005).prefix(*label)));
+                    }
+                    changed
+                })
+                .inner;
+            if changed {
+                panel.edits.write(EditMaterial { index: index as u32, kind: MaterialKind::Diffuse { reflectance: Rgb(rgb) } });
+            }
+        }
+    });
+}
+
+/// A value is committed when typed, or when a drag ends: relighting on every
+/// step of a drag would restart the light each frame.
+fn committed(response: &egui::Response) -> bool {
+    response.drag_stopped() || (response.changed() && !response.dragged())
+}
+
+/// One window material: glass or a panel from the dropdown, then its
+/// transmittance or the panel's keys. The new material, when one is chosen
+/// and builds.
+fn window_material(
+    ui: &mut Ui,
+    edits: &mut MaterialEdits,
+    note: &mut Option<String>,
+    index: u32,
+    kind: &MaterialKind,
+    catalog: &PanelCatalog,
+    base: &Path,
+) -> Option<MaterialKind> {
+    let current = match kind {
+        MaterialKind::Panel { panel, .. } => panel.clone(),
+        _ => "glass".to_string(),
+    };
+    let mut chosen = current.clone();
+    egui::ComboBox::from_id_salt(("window_material", index)).selected_text(&chosen).show_ui(ui, |ui| {
+        ui.selectable_value(&mut chosen, "glass".to_string(), "glass");
+        for name in catalog.names() {
+            ui.selectable_value(&mut chosen, name.to_string(), name);
+        }
+    });
+    if chosen != current {
+        edits.pending.remove(&index);
+        if chosen == "glass" {
+            return Some(MaterialKind::Glass { transmittance: CLEAR_GLASS });
+        }
+        let keys = catalog.get(&chosen).map(|p| p.keys()).unwrap_or_default();
+        let mut values = default_values(keys);
+        for key in keys {
+            if let KeyKind::File { extension } = key.kind
+                && let Some(first) = edits.offered_files(base, extension).first()
+            {
+                values.insert(key.name.to_string(), toml::Value::String(first.clone()));
+            }
+        }
+        let up = match kind {
+            MaterialKind::Panel { up, .. } => *up,
+            _ => None,
+        };
+        return build(note, catalog, &chosen, values, up, base);
+    }
+    match kind {
+        MaterialKind::Glass { transmittance } => {
+            let mut t = *transmittance;
+            committed(&ui.add(egui::Slider::new(&mut t, 0.0..=1.0).text("transmittance"))).then_some(MaterialKind::Glass { transmittance: t })
+        }
+        MaterialKind::Panel { panel, up, parameters, .. } => {
+            let keys = catalog.get(panel).map(|p| p.keys()).unwrap_or_default();
+            let stale = edits.pending.get(&index).is_none_or(|p| p.panel != *panel || p.applied != *parameters);
+            if stale {
+                edits.pending.insert(index, PendingKeys { panel: panel.clone(), applied: parameters.clone(), values: parameters.clone() });
+            }
+            let mut values = edits.pending[&index].values.clone();
+            let mut changed = false;
+            for key in keys {
+                let files = match key.kind {
+                    KeyKind::File { extension } => edits.offered_files(base, extension).to_vec(),
+                    _ => Vec::new(),
+                };
+                changed |= key_widget(ui, key, &mut values, &files, note);
+            }
+            if let Some(pending) = edits.pending.get_mut(&index) {
+                pending.values = values.clone();
+            }
+            if changed { build(note, catalog, panel, values, *up, base) } else { None }
+        }
+        MaterialKind::Diffuse { .. } => None,
+    }
+}
+
+/// The panel material from `values`, or `None` with the reason in `note`
+/// (the material then keeps what it had).
+fn build(note: &mut Option<String>, catalog: &PanelCatalog, panel: &str, values: toml::Table, up: Option<Vec3>, base: &Path) -> Option<MaterialKind> {
+    let parameters = Parameters::new(values, base);
+    match catalog.build(panel, &parameters) {
+        Ok(model) => {
+            *note = None;
+            Some(MaterialKind::Panel { panel: panel.to_string(), up, parameters: parameters.values, model: crate::panel::PanelHandle(model) })
+        }
+        Err(e) => {
+            *note = Some(format!("{panel}: {}: {} (the window keeps its material)", e.key, e.message));
+            None
+        }
+    }
+}
+
+/// The widget of one panel key, editing `values`; true when a change is
+/// committed. Values typed outside the key's range are clamped, with a note.
+fn key_widget(ui: &mut Ui, key: &Key, values: &mut toml::Table, files: &[String], note: &mut Option<String>) -> bool {
+    let number = |v: &toml::Value| v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
+    let given = values.get(key.name).cloned();
+    let label = format!("{} ", key.name);
+    let committed_change = ui
+        .horizontal(|ui| match key.kind {
+            KeyKind::Number { range, default } => {
+                let mut v = given.as_ref().and_then(number).unwrap_or(default);
+                let response = bounded(ui, &mut v, range.0..=range.1, (range.1 - range.0) / 500.0, &label, "", note).on_hover_text(key.help);
+                let commit = committed(&response);
+                values.insert(key.name.into(), toml::Value::Float(v));
+                commit
+            }
+            KeyKind::Numbers { range, default } => {
+                let mut list: Vec<f64> = match &given {
+                    Some(toml::Value::Array(items)) if items.len() == default.len() => items.iter().map(|i| number(i).unwrap_or(range.0)).collect(),
+                    _ => default.to_vec(),
+                };
+                ui.label(&label).on_hover_text(key.help);
+                let mut commit = false;
+                for v in &mut list {
+                    commit |= committed(&bounded(ui, v, range.0..=range.1, (range.1 - range.0) / 500.0, "", "", note));
+                }
+                values.insert(key.name.into(), toml::Value::Array(list.into_iter().map(toml::Value::Float).collect()));
+                commit
+            }
+            KeyKind::Count { range, default } => {
+                let mut v = given.as_ref().and_then(toml::Value::as_integer).unwrap_or(default);
+                let response = ui.add(egui::DragValue::new(&mut v).range(range.0..=range.1).prefix(&label)).on_hover_text(key.help);
+                values.insert(key.name.into(), toml::Value::Integer(v));
+                committed(&response)
+            }
+            KeyKind::File { .. } => {
+                let mut file = given.as_ref().and_then(toml::Value::as_str).unwrap_or_default().to_string();
+                ui.label(&label).on_hover_text(key.help);
+                let mut commit = false;
+                egui::ComboBox::from_id_salt(("key_file", key.name)).selected_text(&file).show_ui(ui, |ui| {
+                    for offered in files {
+                        commit |= ui.selectable_value(&mut file, offered.clone(), offered).clicked();
+                    }
+                });
+                values.insert(key.name.into(), toml::Value::String(file));
+                commit
+            }
+        })
+        .inner;
+    committed_change
+}
+
+impl MaterialEdits {
+    /// Files with `extension` in the scene's folder or its two parents (a few
+    /// levels down), as paths relative to the scene's folder; found once.
+    fn offered_files(&mut self, base: &Path, extension: &'static str) -> &[String] {
+        self.files.entry(extension).or_insert_with(|| {
+            let mut found = Vec::new();
+            let mut seen = std::collections::HashSet::new();
+            let Ok(mut folder) = std::fs::canonicalize(if base.as_os_str().is_empty() { Path::new(".") } else { base }) else { return found };
+            let mut relative = PathBuf::new();
+            let mut budget = FILE_SEARCH_ENTRIES;
+            for _ in 0..3 {
+                collect_files(&folder, &relative, extension, FILE_SEARCH_DEPTH, &mut budget, &mut seen, &mut found);
+                let Some(parent) = folder.parent() else { break };
+                folder = parent.to_path_buf();
+                relative.push("..");
+            }
+            found.sort();
+            found
+        })
+    }
+}
+
+/// Files with `extension` under `dir` (down to `depth` folders), named
+/// relative to the scene's folder; each file once, by its first name.
+fn collect_files(dir: &Path, relative: &Path, extension: &str, depth: usize, budget: &mut usize, seen: &mut std::collections::HashSet<PathBuf>, found: &mut Vec<String>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for entry in entries.flatten() {
+        if *budget == 0 {
+            return;
+        }
+        *budget -= 1;
+        let path = entry.path();
+        let name = relative.join(entry.file_name());
+        if path.is_dir() && depth > 0 {
+            collect_files(&path, &name, extension, depth - 1, budget, seen, found);
+        } else if path.extension().is_some_and(|e| e.eq_ignore_ascii_case(extension)) && seen.insert(path) {
+            found.push(name.to_string_lossy().replace('\\', "/"));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::panel::PanelCatalog;
+
+    #[test]
+    fn windows_are_grouped_by_material_and_the_way_they_face() {
+        let scene = crate::scene::load_scene(&crate::bundled_scene("office"), &PanelCatalog::new()).unwrap().scene;
+        let name = |g: &WindowGroup| scene.materials[g.material as usize].name.clone();
+        let groups: Vec<(String, &str)> = window_groups(&scene, 0.0).iter().map(|g| (name(g), g.facing)).collect();
+        for expected in [("upper_glass", "west"), ("view_glass", "west")] {
+            assert!(groups.iter().any(|(n, f)| n == expected.0 && *f == expected.1), "{groups:?}");
+        }
+        assert!(groups.iter().any(|(_, f)| *f == "skylight"), "{groups:?}");
+        let area: f64 = window_groups(&scene, 0.0).iter().map(|g| g.area).sum();
+        assert!((area - scene.windows.iter().map(|w| f64::from(w.area)).sum::<f64>()).abs() < 1e-6);
+        // True north turned to the model's +x: the west windows face south.
+        let turned: Vec<&str> = window_groups(&scene, 90.0).iter().filter(|g| name(g) == "upper_glass").map(|g| g.facing).collect();
+        assert_eq!(turned, ["south"]);
+    }
+}
