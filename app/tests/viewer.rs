@@ -1,6 +1,6 @@
 //! The viewer in a window, under Xvfb with Mesa's software Vulkan driver:
-//! `heliodon view SCENE --screenshot FILE` waits for the light, saves the
-//! window with its panels and exits.
+//! `heliodon view SCENE --screenshot FILE --hdr FILE` waits for the light,
+//! saves the window with its panels and the 3D view's luminance, and exits.
 
 use std::path::Path;
 use std::process::Command;
@@ -10,13 +10,17 @@ fn view_screenshot_shows_the_panels_and_the_lit_model() {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viewer_screenshot");
     std::fs::create_dir_all(&dir).unwrap();
     let shot = dir.join("test_room.png");
+    let hdr = dir.join("test_room.hdr");
     let _ = std::fs::remove_file(&shot);
+    let _ = std::fs::remove_file(&hdr);
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes/test_room/scene.toml");
     let out = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 1280x800x24", env!("CARGO_BIN_EXE_heliodon"), "view"])
         .arg(&scene)
         .args(["--date", "2026-03-21", "--time", "10:00", "--screenshot"])
         .arg(&shot)
+        .arg("--hdr")
+        .arg(&hdr)
         .env("HELIODON_CACHE_DIR", dir.join("cache"))
         .output()
         .expect("xvfb-run (tools/system-deps installs it)");
@@ -38,4 +42,47 @@ fn view_screenshot_shows_the_panels_and_the_lit_model() {
     let mid = middle.iter().filter(|&&l| (50..200).contains(&l)).count();
     assert!(bright > middle.len() / 50, "sun patches: {bright} of {}", middle.len());
     assert!(mid > middle.len() / 3, "lit surfaces: {mid} of {}", middle.len());
+
+    // The luminance saved from the viewer is the view the window shows: the
+    // headless renderer draws the same view at the same size to the same
+    // values.
+    let (width, height, viewed) = read_hdr(&hdr);
+    assert!(width > 400 && width < 1280 && height == 800, "{width} × {height}: the 3D view between the panels");
+    let rendered = dir.join("test_room_render.hdr");
+    let out = Command::new(env!("CARGO_BIN_EXE_heliodon"))
+        .arg("render")
+        .arg(&scene)
+        .args(["--date", "2026-03-21", "--time", "10:00", "--width", &width.to_string(), "--height", &height.to_string(), "--out"])
+        .arg(dir.join("test_room_render.png"))
+        .arg("--hdr")
+        .arg(&rendered)
+        .env("HELIODON_CACHE_DIR", dir.join("cache"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (w, h, reference) = read_hdr(&rendered);
+    assert_eq!((w, h), (width, height));
+    let sum = |p: &[f32; 3]| p[0] + p[1] + p[2];
+    let lit: Vec<f32> = viewed.iter().zip(&reference).filter(|(_, r)| sum(r) > 1e-3).map(|(v, r)| (sum(v) / sum(r) - 1.0).abs()).collect();
+    let close = lit.iter().filter(|e| **e < 0.02).count() as f64 / lit.len() as f64;
+    let peak = reference.iter().map(sum).fold(0.0, f32::max);
+    println!("viewer HDR vs render HDR: {} lit pixels, {:.2}% within 2%, peak {peak} W/sr/m²", lit.len(), 100.0 * close);
+    assert!(lit.len() > viewed.len() * 9 / 10, "a lit view");
+    assert!(close > 0.98, "{:.4} of the pixels within 2%", close);
+}
+
+/// A flat (not run-length encoded) Radiance picture, as heliodon writes it.
+fn read_hdr(path: &Path) -> (usize, usize, Vec<[f32; 3]>) {
+    let bytes = std::fs::read(path).unwrap();
+    let text_end = bytes.windows(2).position(|w| w == b"\n\n").unwrap() + 2;
+    let size_end = text_end + bytes[text_end..].iter().position(|&b| b == b'\n').unwrap();
+    let size = std::str::from_utf8(&bytes[text_end..size_end]).unwrap();
+    let fields: Vec<&str> = size.split_whitespace().collect();
+    let (height, width): (usize, usize) = (fields[1].parse().unwrap(), fields[3].parse().unwrap());
+    let pixels = bytes[size_end + 1..]
+        .chunks_exact(4)
+        .map(|p| if p[3] == 0 { [0.0; 3] } else { [0, 1, 2].map(|c| (f32::from(p[c]) + 0.5) * 2f32.powi(i32::from(p[3]) - 136)) })
+        .collect::<Vec<_>>();
+    assert_eq!(pixels.len(), width * height, "{}", path.display());
+    (width, height, pixels)
 }

@@ -70,13 +70,19 @@ impl RenderedImage {
     /// W/sr/m² per channel, so Radiance's tools (ximage, pcond, pvalue)
     /// read the same luminance (179 lm/W).
     pub fn save_hdr(&self, path: &Path) -> Result<(), String> {
-        let mut out = Vec::with_capacity(self.physical.len() * 4 + 128);
-        let _ = write!(out, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\nEXPOSURE=1\nSOFTWARE=heliodon\n\n-Y {} +X {}\n", self.height, self.width);
-        for pixel in &self.physical {
-            out.extend(rgbe(pixel.map(|c| c / LUMINOUS_EFFICACY as f32)));
-        }
-        std::fs::write(path, out).map_err(|e| format!("{}: cannot write image: {e}", path.display()))
+        save_hdr(path, self.width, self.height, &self.physical)
     }
+}
+
+/// Writes luminance pixels (cd/m², row-major) as a Radiance picture (RGBE)
+/// in W/sr/m² per channel (179 lm/W), as Radiance's tools expect.
+pub fn save_hdr(path: &Path, width: u32, height: u32, physical: &[[f32; 3]]) -> Result<(), String> {
+    let mut out = Vec::with_capacity(physical.len() * 4 + 128);
+    let _ = write!(out, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\nEXPOSURE=1\nSOFTWARE=heliodon\n\n-Y {height} +X {width}\n");
+    for pixel in physical {
+        out.extend(rgbe(pixel.map(|c| c / LUMINOUS_EFFICACY as f32)));
+    }
+    std::fs::write(path, out).map_err(|e| format!("{}: cannot write image: {e}", path.display()))
 }
 
 /// Radiance's shared-exponent encoding of one pixel.
@@ -97,7 +103,7 @@ fn rgbe(rgb: [f32; 3]) -> [u8; 4] {
 const WARM_UP_FRAMES: u32 = 5;
 
 /// Exposure value at which the view's exposure factor is 1 (Bevy: 2^-EV / 1.2).
-fn unit_exposure() -> Exposure {
+pub fn unit_exposure() -> Exposure {
     Exposure { ev100: (1.0f32 / 1.2).log2() }
 }
 

@@ -72,23 +72,33 @@ pub fn navigate(
     ray_model: Option<Res<crate::render::RayModel>>,
     time: Res<Time>,
     mut cameras: Query<(&mut CadCamera, &mut Transform, &Camera, &GlobalTransform, &Projection)>,
+    mut drag_in_view: Local<bool>,
 ) {
-    // The pointer over a panel belongs to the panel.
-    if ui.as_ref().is_some_and(|ui| ui.pointer_over_panels) {
-        return;
-    }
+    let over_panels = ui.as_ref().is_some_and(|ui| ui.pointer_over_panels);
     let walking = ui.is_some_and(|ui| ui.walk);
+    let buttons = [MouseButton::Left, MouseButton::Right, MouseButton::Middle];
     for (mut cad, mut transform, camera, global, projection) in &mut cameras {
         let fov = match projection {
             Projection::Perspective(p) => p.fov,
             _ => std::f32::consts::FRAC_PI_3,
         };
-        let delta = motion.delta;
-        let cursor_ray = window.cursor_position().and_then(|cursor| {
-            // Cursor positions are in the window; the camera's are in its viewport.
-            let offset = camera.viewport.as_ref().map_or(Vec2::ZERO, |v| v.physical_position.as_vec2() / window.scale_factor());
-            camera.viewport_to_world(global, cursor - offset).ok()
-        });
+        // The pointer belongs to the view only inside its viewport and off
+        // the panels; a drag belongs to where it started. (The panels' flag
+        // is a frame old, so a press that lands with a jump of the pointer
+        // is told apart by the viewport alone.)
+        let cursor = cursor_in_view(&window, camera).filter(|_| !over_panels);
+        if mouse.any_just_pressed(buttons) {
+            *drag_in_view = cursor.is_some();
+        } else if !mouse.any_pressed(buttons) {
+            *drag_in_view = false;
+        }
+        let delta = if *drag_in_view { motion.delta } else { Vec2::ZERO };
+        let cursor_ray = cursor.and_then(|cursor| camera.viewport_to_world(global, cursor).ok());
+        if over_panels && !*drag_in_view {
+            // Keys typed into a panel are not for the camera either.
+            *transform = cad.transform();
+            continue;
+        }
         if mouse.just_pressed(MouseButton::Left)
             && !walking
             && let (Some(ray), Some(model)) = (cursor_ray, ray_model.as_ref())
@@ -131,7 +141,7 @@ pub fn navigate(
             MouseScrollUnit::Line => scroll.delta.y,
             MouseScrollUnit::Pixel => scroll.delta.y / PIXELS_PER_LINE,
         };
-        if lines != 0.0 {
+        if lines != 0.0 && cursor.is_some() {
             let factor = ZOOM_STEP.powf(lines);
             // Scale the eye and the focus about the point under the cursor on
             // the plane through the focus facing the camera.
@@ -154,6 +164,18 @@ pub fn navigate(
         }
         *transform = cad.transform();
     }
+}
+
+/// The cursor in `camera`'s viewport coordinates, when it is inside the
+/// viewport (the panels shift and narrow it).
+pub fn cursor_in_view(window: &Window, camera: &Camera) -> Option<Vec2> {
+    let cursor = window.cursor_position()?;
+    let (offset, size) = match &camera.viewport {
+        Some(v) => (v.physical_position.as_vec2() / window.scale_factor(), v.physical_size.as_vec2() / window.scale_factor()),
+        None => (Vec2::ZERO, Vec2::new(window.width(), window.height())),
+    };
+    let local = cursor - offset;
+    (local.cmpge(Vec2::ZERO).all() && local.cmplt(size).all()).then_some(local)
 }
 
 #[cfg(test)]

@@ -224,7 +224,7 @@ fn build(note: &mut Option<String>, catalog: &PanelCatalog, panel: &str, values:
     let parameters = Parameters::new(values, base);
     match catalog.build(panel, &parameters) {
         Ok(model) => {
-            *note = None;
+            // A note from this edit (a clamped value) stays on show.
             Some(MaterialKind::Panel { panel: panel.to_string(), up, parameters: parameters.values, model: crate::panel::PanelHandle(model) })
         }
         Err(e) => {
@@ -329,7 +329,59 @@ fn collect_files(dir: &Path, relative: &Path, extension: &str, depth: usize, bud
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::panel::PanelCatalog;
+    use crate::panel::{PanelModel, PanelResponse, PanelType, ParameterError};
+    use std::sync::Arc;
+
+    /// A panel whose two shares may not add up to more than 1.
+    struct Shares;
+    const A: Key = Key::number("a", "", (0.0, 1.0), 0.5);
+    const B: Key = Key::number("b", "", (0.0, 1.0), 0.25);
+
+    impl PanelType for Shares {
+        fn name(&self) -> &str {
+            "shares"
+        }
+        fn keys(&self) -> &[Key] {
+            &[A, B]
+        }
+        fn build(&self, p: &Parameters) -> Result<Arc<dyn PanelModel>, ParameterError> {
+            let (a, b) = (p.number(&A)?, p.number(&B)?);
+            if a + b > 1.0 {
+                return Err(ParameterError::new("b", format!("a + b = {} is more than 1", a + b)));
+            }
+            Ok(Arc::new(Open))
+        }
+    }
+
+    #[derive(Debug)]
+    struct Open;
+    impl PanelModel for Open {
+        fn response(&self, _: glam::DVec3) -> PanelResponse {
+            PanelResponse { absorbed: 1.0, ..Default::default() }
+        }
+    }
+
+    #[test]
+    fn panel_keys_out_of_range_are_clamped_and_failed_builds_keep_the_material() {
+        let mut catalog = PanelCatalog::new();
+        catalog.register(Arc::new(Shares));
+        let mut note = None;
+        // The defaults build.
+        assert!(build(&mut note, &catalog, "shares", default_values(Shares.keys()), None, Path::new("")).is_some());
+        // A value past its range is clamped, with a note.
+        let mut values: toml::Table = toml::from_str("a = 5.0\nb = 0.0").unwrap();
+        let ctx = egui::Context::default();
+        let mut output = ctx.run_ui(egui::RawInput::default(), |ui| {
+            key_widget(ui, &A, &mut values, &[], &mut note);
+        });
+        output.textures_delta.clear();
+        assert_eq!(values["a"].as_float(), Some(1.0));
+        assert_eq!(note.as_deref(), Some("a 5 is outside 0..1: 1 is used"));
+        // Keys that do not build together: no material, and why.
+        values.insert("b".into(), toml::Value::Float(0.5));
+        assert!(build(&mut note, &catalog, "shares", values, None, Path::new("")).is_none());
+        assert_eq!(note.as_deref(), Some("shares: b: a + b = 1.5 is more than 1 (the window keeps its material)"));
+    }
 
     #[test]
     fn windows_are_grouped_by_material_and_the_way_they_face() {

@@ -5,6 +5,7 @@
 //! and exits (`heliodon view SCENE --screenshot FILE`).
 
 pub mod camera;
+pub mod capture;
 pub mod lobes;
 pub mod materials;
 pub mod sensors;
@@ -13,11 +14,16 @@ pub mod ui;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use bevy::camera::visibility::RenderLayers;
 use bevy::prelude::*;
 
 use crate::ecs::{ActiveScene, HeliodonPlugins, HeliodonSystems, OpenScene, SceneLoadFailed, SceneSpawned};
 use crate::render::{HeliodonRenderPlugin, initial_view};
 use camera::CadCamera;
+
+/// The render layer of what is drawn over the model for the person looking
+/// (sensor markers, lobe arrows): not in saved luminance pictures.
+pub const OVERLAY_LAYER: usize = 1;
 
 /// Window, input and camera.
 pub struct ViewerPlugin {
@@ -29,6 +35,8 @@ pub struct ViewerPlugin {
 #[derive(Resource, Debug, Clone)]
 pub struct ViewStart {
     pub screenshot: Option<PathBuf>,
+    /// With or without `screenshot`: the 3D view's luminance as a Radiance picture.
+    pub hdr: Option<PathBuf>,
     pub when: Option<crate::time::LocalDateTime>,
     pub sky: Option<crate::sky::SkySpec>,
 }
@@ -39,14 +47,21 @@ impl Plugin for ViewerPlugin {
         app.add_systems(Startup, move |mut open: MessageWriter<OpenScene>| {
             open.write(OpenScene(scene.clone()));
         })
-        .add_systems(Startup, |mut commands: Commands| {
-            commands.spawn((crate::render::hybrid_camera(), CadCamera::looking(Vec3::new(-8.0, -10.0, 8.0), Vec3::ZERO)));
+        .add_systems(Startup, |mut commands: Commands, mut gizmos: ResMut<GizmoConfigStore>| {
+            // The person's view shows the model and the overlays; a saved
+            // luminance picture shows the model alone.
+            gizmos.config_mut::<DefaultGizmoConfigGroup>().0.render_layers = RenderLayers::layer(OVERLAY_LAYER);
+            commands.spawn((
+                crate::render::hybrid_camera(),
+                CadCamera::looking(Vec3::new(-8.0, -10.0, 8.0), Vec3::ZERO),
+                RenderLayers::from_layers(&[0, OVERLAY_LAYER]),
+            ));
         })
         .add_systems(
             Update,
             (frame_new_scene, exit_on_failed_load).after(HeliodonSystems::SpawnScene),
         )
-        .add_plugins(ui::DesignerUiPlugin)
+        .add_plugins((ui::DesignerUiPlugin, capture::CapturePlugin))
         .add_systems(Update, camera::navigate.after(frame_new_scene))
         .add_systems(Startup, apply_view_start)
         .add_systems(Update, take_screenshot.after(HeliodonSystems::Lighting))
@@ -110,44 +125,39 @@ fn apply_view_start(request: Option<Res<ViewStart>>, mut time: ResMut<crate::ecs
 /// Frames drawn after the light converges before the window is saved.
 const SETTLE_FRAMES: u32 = 10;
 
-/// Saves the window once the light has converged, then exits.
+/// Saves the window (and the view's luminance) once the light has
+/// converged, then exits.
 fn take_screenshot(
-    mut commands: Commands,
     request: Option<Res<ViewStart>>,
     lighting: Option<Res<crate::ecs::LightingState>>,
+    results: Res<capture::SaveResults>,
+    mut saves: MessageWriter<capture::SaveView>,
     mut frames: Local<u32>,
     mut exit: MessageWriter<AppExit>,
 ) {
-    let Some(path) = request.and_then(|r| r.screenshot.clone()) else { return };
-    if !lighting.is_some_and(|l| l.converged) {
-        *frames = 0;
+    let Some(request) = request else { return };
+    let wanted: Vec<capture::SaveView> =
+        request.screenshot.clone().map(capture::SaveView::Png).into_iter().chain(request.hdr.clone().map(capture::SaveView::Hdr)).collect();
+    if wanted.is_empty() {
+        return;
+    }
+    if *frames < SETTLE_FRAMES {
+        *frames = if lighting.is_some_and(|l| l.converged) { *frames + 1 } else { 0 };
+        if *frames == SETTLE_FRAMES {
+            saves.write_batch(wanted);
+        }
         return;
     }
     *frames += 1;
-    if *frames == SETTLE_FRAMES {
-        commands.spawn(bevy::render::view::screenshot::Screenshot::primary_window()).observe(
-            move |captured: On<bevy::render::view::screenshot::ScreenshotCaptured>, mut exit: MessageWriter<AppExit>| {
-                let saved = captured
-                    .image
-                    .clone()
-                    .try_into_dynamic()
-                    .map_err(|e| e.to_string())
-                    .and_then(|image| image.to_rgb8().save(&path).map_err(|e| e.to_string()));
-                match saved {
-                    Ok(()) => {
-                        exit.write(AppExit::Success);
-                    }
-                    Err(error) => {
-                        eprintln!("error: {}: cannot save the screenshot: {error}", path.display());
-                        exit.write(AppExit::error());
-                    }
-                }
-            },
-        );
-    }
-    // A screenshot that never arrives must not keep the viewer open forever.
-    if *frames > SETTLE_FRAMES + 600 {
-        eprintln!("error: the screenshot was not captured");
+    if results.0.len() >= wanted.len() {
+        let failures: Vec<&String> = results.0.iter().filter_map(|r| r.as_ref().err()).collect();
+        for failure in &failures {
+            eprintln!("error: {failure}");
+        }
+        exit.write(if failures.is_empty() { AppExit::Success } else { AppExit::error() });
+    } else if *frames > SETTLE_FRAMES + 600 {
+        // A capture that never arrives must not keep the viewer open forever.
+        eprintln!("error: the view was not captured");
         exit.write(AppExit::error());
     }
 }

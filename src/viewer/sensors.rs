@@ -165,24 +165,24 @@ pub fn pick_sensor(
     mut pressed_at: Local<Option<Vec2>>,
     mut selected: ResMut<SelectedSensor>,
 ) {
-    let Some(cursor) = window.cursor_position() else { return };
+    let (Some(scene), Ok((camera, transform))) = (&active.scene, camera.single()) else { return };
+    // A click in the view, off the panels, that does not move.
+    let cursor = super::camera::cursor_in_view(&window, camera).filter(|_| !ui.pointer_over_panels);
     if mouse.just_pressed(MouseButton::Left) {
-        *pressed_at = Some(cursor);
+        *pressed_at = cursor;
     }
-    if !mouse.just_released(MouseButton::Left) || ui.pointer_over_panels {
+    if !mouse.just_released(MouseButton::Left) {
         return;
     }
-    let Some(start) = pressed_at.take() else { return };
+    let (Some(start), Some(cursor)) = (pressed_at.take(), cursor) else { return };
     if start.distance(cursor) > 4.0 {
         return;
     }
-    let (Some(scene), Ok((camera, transform))) = (&active.scene, camera.single()) else { return };
-    let offset = camera.viewport.as_ref().map_or(Vec2::ZERO, |v| v.physical_position.as_vec2() / window.scale_factor());
     let nearest = scene
         .sensors
         .iter()
         .enumerate()
-        .filter_map(|(i, s)| camera.world_to_viewport(transform, s.position).ok().map(|p| (i, (p + offset).distance(cursor))))
+        .filter_map(|(i, s)| camera.world_to_viewport(transform, s.position).ok().map(|p| (i, p.distance(cursor))))
         .filter(|(_, d)| *d < 14.0)
         .min_by(|a, b| a.1.total_cmp(&b.1));
     if let Some((i, _)) = nearest {

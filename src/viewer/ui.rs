@@ -8,6 +8,7 @@
 //! panels, and the pointer over a panel belongs to the panel.
 
 use bevy::camera::visibility::RenderLayers;
+use bevy::diagnostic::{DiagnosticsStore, FrameTimeDiagnosticsPlugin};
 use bevy::camera::{CameraOutputMode, Viewport};
 use bevy::prelude::*;
 use bevy::render::render_resource::BlendState;
@@ -16,9 +17,11 @@ use bevy_egui::egui::{self, LayerId, Ui, UiBuilder};
 use bevy_egui::{EguiContexts, EguiGlobalSettings, EguiPlugin, EguiPrimaryContextPass, PrimaryEguiContext};
 
 use bevy::ecs::system::SystemParam;
+use std::path::PathBuf;
 
 use super::camera::CadCamera;
 use super::sensors::{DAY_STEPS, DaySeries, SelectedSensor, YEAR_DAYS, YearMap};
+use super::capture::{SaveResults, SaveView};
 use super::materials::{MaterialEdits, MaterialPanel, material_panel};
 use crate::ecs::{ActiveScene, LightEngine, LightingState, Site, SkyChoice, SolarTime, SunSky};
 use crate::scene::Viewpoint;
@@ -32,6 +35,9 @@ pub struct DesignerUiPlugin;
 
 impl Plugin for DesignerUiPlugin {
     fn build(&self, app: &mut App) {
+        if !app.is_plugin_added::<FrameTimeDiagnosticsPlugin>() {
+            app.add_plugins(FrameTimeDiagnosticsPlugin::default());
+        }
         app.add_plugins(EguiPlugin::default())
             .init_resource::<UiState>()
             .init_resource::<SelectedSensor>()
@@ -45,6 +51,7 @@ impl Plugin for DesignerUiPlugin {
                     play_the_day,
                     apply_camera_request,
                     save_image,
+                    note_saves.run_if(resource_changed::<SaveResults>),
                     super::sensors::pick_sensor,
                     super::sensors::update_day_series,
                     super::sensors::update_year_map,
@@ -68,10 +75,27 @@ pub struct UiState {
     pub walk: bool,
     /// A camera change asked for by the panel, applied by [`apply_camera_request`].
     pub camera_request: Option<CameraRequest>,
-    /// Save the window as a PNG (in the working folder).
-    pub save_image: bool,
+    /// Save the window as a PNG, or the view's luminance as an HDR (in the
+    /// working folder).
+    pub save_image: Option<ImageFormat>,
     /// What the materials panel is editing.
     pub materials: MaterialEdits,
+}
+
+/// The files the view can be saved as.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageFormat {
+    Png,
+    Hdr,
+}
+
+impl ImageFormat {
+    fn extension(self) -> &'static str {
+        match self {
+            ImageFormat::Png => "png",
+            ImageFormat::Hdr => "hdr",
+        }
+    }
 }
 
 /// The camera changes the panel offers.
@@ -146,7 +170,10 @@ fn panels(
     mut materials: MaterialPanel,
     window: Single<&Window, With<PrimaryWindow>>,
     mut cameras: Query<&mut Camera, crate::render::PictureCamera>,
+    diagnostics: Res<DiagnosticsStore>,
 ) -> Result {
+    // Frame time, smoothed and the worst of the recent history (ms).
+    let frame_time = diagnostics.get(&FrameTimeDiagnosticsPlugin::FRAME_TIME).and_then(|d| Some((d.smoothed()?, d.values().copied().fold(0.0, f64::max))));
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(ctx.clone(), "viewport".into(), UiBuilder::new().layer_id(LayerId::background()).max_rect(ctx.viewport_rect()));
     let left = egui::Panel::left("sun_and_sky")
@@ -171,7 +198,7 @@ fn panels(
             egui::ScrollArea::vertical().show(ui, |ui| {
                 camera_panel(ui, &mut ui_state, &sensors.active);
                 ui.separator();
-                view_panel(ui, &mut ui_state, &mut settings, sensors.lighting.as_deref(), sensors.engine.as_deref());
+                view_panel(ui, &mut ui_state, &mut settings, sensors.lighting.as_deref(), sensors.engine.as_deref(), frame_time);
                 ui.separator();
                 sensor_panel(ui, &mut ui_state, &mut sensors, &solar);
             });
@@ -396,7 +423,7 @@ fn sky_controls(ui: &mut Ui, sky: &mut ResMut<SkyChoice>, note: &mut Option<Stri
     }
 }
 
-fn view_panel(ui: &mut Ui, state: &mut UiState, settings: &mut ResMut<RenderSettings>, lighting: Option<&LightingState>, engine: Option<&LightEngine>) {
+fn view_panel(ui: &mut Ui, state: &mut UiState, settings: &mut ResMut<RenderSettings>, lighting: Option<&LightingState>, engine: Option<&LightEngine>, frame_time: Option<(f64, f64)>) {
     ui.heading("View");
     let labels = [(RenderMode::Full, "full"), (RenderMode::Sun, "direct sun"), (RenderMode::Sky, "direct sky"), (RenderMode::Indirect, "indirect"), (RenderMode::FalseColour, "false colour (lux)")];
     let mut mode = settings.mode;
@@ -429,9 +456,17 @@ fn view_panel(ui: &mut Ui, state: &mut UiState, settings: &mut ResMut<RenderSett
         _ => "waiting for the light".to_string(),
     };
     ui.label(progress);
-    if ui.button("Save image (PNG)").clicked() {
-        state.save_image = true;
+    if let Some((smoothed, worst)) = frame_time {
+        ui.label(format!("frame {smoothed:.0} ms ({:.0} fps), worst recent {worst:.0} ms", 1000.0 / smoothed.max(1e-3)));
     }
+    ui.horizontal(|ui| {
+        if ui.button("Save image (PNG)").clicked() {
+            state.save_image = Some(ImageFormat::Png);
+        }
+        if ui.button("Save luminance (HDR)").on_hover_text("the 3D view in cd/m², as a Radiance picture").clicked() {
+            state.save_image = Some(ImageFormat::Hdr);
+        }
+    });
 }
 
 /// Camera presets, the scene's and the user's viewpoints, walk mode.
@@ -594,14 +629,26 @@ pub fn apply_camera_request(mut state: ResMut<UiState>, active: Res<ActiveScene>
     }
 }
 
-/// Saves the window when asked.
-fn save_image(mut state: ResMut<UiState>, mut commands: Commands) {
-    if !std::mem::take(&mut state.save_image) {
-        return;
+/// Saves the view when asked, into the working folder, named by the time.
+fn save_image(mut state: ResMut<UiState>, mut saves: MessageWriter<SaveView>) {
+    let Some(format) = state.save_image.take() else { return };
+    let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
+    let name = PathBuf::from(format!("heliodon-view-{stamp}.{}", format.extension()));
+    state.note = Some(format!("saving {}", name.display()));
+    saves.write(match format {
+        ImageFormat::Png => SaveView::Png(name),
+        ImageFormat::Hdr => SaveView::Hdr(name),
+    });
+}
+
+/// The outcome of the last save, as the note.
+fn note_saves(results: Res<SaveResults>, mut state: ResMut<UiState>) {
+    if let Some(last) = results.0.last() {
+        state.note = Some(match last {
+            Ok(path) => format!("wrote {}", std::env::current_dir().map(|d| d.join(path)).unwrap_or(path.clone()).display()),
+            Err(message) => message.clone(),
+        });
     }
-    let name = format!("heliodon-view-{}.png", std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs()));
-    state.note = Some(format!("saving {name}"));
-    commands.spawn(bevy::render::view::screenshot::Screenshot::primary_window()).observe(bevy::render::view::screenshot::save_to_disk(name));
 }
 
 /// The false-colour scale as a bar with its decades.
