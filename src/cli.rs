@@ -68,6 +68,12 @@ pub struct ViewArgs {
     /// Wait until the light has converged, save the 3D view's luminance to FILE (Radiance RGBE, W/sr/m² at 179 lm/W) and exit
     #[arg(long, value_name = "FILE")]
     pub hdr: Option<PathBuf>,
+    /// Select the sensor NAME: its day is plotted (and, with --screenshot, waited for)
+    #[arg(long, value_name = "NAME")]
+    pub sensor: Option<String>,
+    /// With --sensor: also compute its year map (day of year × time of day)
+    #[arg(long, requires = "sensor")]
+    pub year: bool,
     /// Local date, YYYY-MM-DD
     #[arg(long, value_parser = Date::parse)]
     pub date: Option<Date>,
@@ -383,7 +389,7 @@ fn view_request(args: &ViewArgs) -> Result<crate::viewer::ViewStart, String> {
     let default = crate::ecs::SolarTime::default().0;
     let when = (args.date.is_some() || args.time.is_some())
         .then(|| LocalDateTime { date: args.date.unwrap_or(default.date), time: args.time.unwrap_or(default.time) });
-    Ok(crate::viewer::ViewStart { screenshot: args.screenshot.clone(), hdr: args.hdr.clone(), when, sky })
+    Ok(crate::viewer::ViewStart { screenshot: args.screenshot.clone(), hdr: args.hdr.clone(), sensor: args.sensor.clone(), year: args.year, when, sky })
 }
 
 /// The `render` command.

@@ -180,6 +180,12 @@ fn a_room_without_windows_is_dark_and_the_night_has_no_sun() {
     let model = LightModel::precompute(scene.clone(), quick()).unwrap();
     let night = model.solve(&sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-06-21", "23:00"), None);
     assert!(night.sensors.iter().all(|r| r.direct_sun == 0.0 && r.total == 0.0));
+    // Warm-started from the day (as the viewer's relights and day plots are),
+    // the night is as dark.
+    let day = model.solve(&sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-06-21", "19:00"), None);
+    assert!(day.sensors.iter().all(|r| r.total > 0.0));
+    let night = model.solve(&sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-06-21", "23:00"), Some(&day));
+    assert!(night.sensors.iter().all(|r| r.total == 0.0), "{:?}", night.sensors[0]);
 }
 
 #[test]

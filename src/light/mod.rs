@@ -636,7 +636,16 @@ impl LightModel {
             out
         });
         let indirect = match warm {
-            Some(w) if w.sides.len() == direct.len() => w.sides.iter().map(|c| c.indirect).collect(),
+            Some(w) if w.sides.len() == direct.len() => {
+                // Scaled by how much the direct light changed: close when the
+                // sun moves a little, and dark at once when the light is gone
+                // (unscaled, a day's light would fade over every iteration
+                // the budget allows and leave a glow in the night).
+                let before: f64 = w.sides.iter().map(|c| c.sun + c.sky).sum();
+                let now: f64 = direct.iter().map(|c| c.sun + c.sky).sum();
+                let scale = if before > 0.0 { now / before } else { 0.0 };
+                w.sides.iter().map(|c| c.indirect.map(|e| e * scale)).collect()
+            }
             _ => vec![[0.0; 3]; direct.len()],
         };
         let mean_direct = direct.iter().map(|c| c.sun + c.sky).sum::<f64>() / direct.len().max(1) as f64;

@@ -37,6 +37,10 @@ pub struct ViewStart {
     pub screenshot: Option<PathBuf>,
     /// With or without `screenshot`: the 3D view's luminance as a Radiance picture.
     pub hdr: Option<PathBuf>,
+    /// The sensor to select (its day is plotted, and waited for before saving).
+    pub sensor: Option<String>,
+    /// Also compute the selected sensor's year map (and wait for it).
+    pub year: bool,
     pub when: Option<crate::time::LocalDateTime>,
     pub sky: Option<crate::sky::SkySpec>,
 }
@@ -64,7 +68,7 @@ impl Plugin for ViewerPlugin {
         .add_plugins((ui::DesignerUiPlugin, capture::CapturePlugin))
         .add_systems(Update, camera::navigate.after(frame_new_scene))
         .add_systems(Startup, apply_view_start)
-        .add_systems(Update, take_screenshot.after(HeliodonSystems::Lighting))
+        .add_systems(Update, (select_start_sensor.after(HeliodonSystems::SpawnScene), take_screenshot.after(HeliodonSystems::Lighting)))
         .init_resource::<lobes::ShownLobes>()
         .add_systems(Update, (lobes::select_panel_window, lobes::draw_lobes).chain().after(HeliodonSystems::UpdateSunSky));
     }
@@ -122,6 +126,35 @@ fn apply_view_start(request: Option<Res<ViewStart>>, mut time: ResMut<crate::ecs
     }
 }
 
+/// Selects the sensor `view --sensor` names when the scene opens (and asks
+/// for its year with `--year`); a name the scene lacks ends the viewer with
+/// one line.
+fn select_start_sensor(
+    request: Option<Res<ViewStart>>,
+    mut spawned: MessageReader<SceneSpawned>,
+    active: Res<ActiveScene>,
+    mut selected: ResMut<sensors::SelectedSensor>,
+    mut year: ResMut<sensors::YearMap>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    if spawned.read().last().is_none_or(|s| s.edited) {
+        return;
+    }
+    let (Some(request), Some(scene)) = (request, &active.scene) else { return };
+    let Some(name) = &request.sensor else { return };
+    match scene.sensors.iter().position(|s| s.name == *name) {
+        Some(index) => {
+            selected.0 = Some(index);
+            year.requested = request.year;
+        }
+        None => {
+            let names: Vec<&str> = scene.sensors.iter().map(|s| s.name.as_str()).take(12).collect();
+            eprintln!("error: --sensor {name}: {} has no sensor of that name (its sensors: {}{})", scene.files.scene.display(), names.join(", "), if scene.sensors.len() > 12 { ", …" } else { "" });
+            exit.write(AppExit::error());
+        }
+    }
+}
+
 /// Frames drawn after the light converges before the window is saved.
 const SETTLE_FRAMES: u32 = 10;
 
@@ -130,6 +163,9 @@ const SETTLE_FRAMES: u32 = 10;
 fn take_screenshot(
     request: Option<Res<ViewStart>>,
     lighting: Option<Res<crate::ecs::LightingState>>,
+    selected: Res<sensors::SelectedSensor>,
+    day: Res<sensors::DaySeries>,
+    year: Res<sensors::YearMap>,
     results: Res<capture::SaveResults>,
     mut saves: MessageWriter<capture::SaveView>,
     mut frames: Local<u32>,
@@ -142,7 +178,9 @@ fn take_screenshot(
         return;
     }
     if *frames < SETTLE_FRAMES {
-        *frames = if lighting.is_some_and(|l| l.converged) { *frames + 1 } else { 0 };
+        // The light has converged, and the selected sensor's day (and year) are in.
+        let plots_in = selected.0.is_none() || (day.0.values.is_some() && (!request.year || year.map.values.is_some()));
+        *frames = if lighting.is_some_and(|l| l.converged) && plots_in { *frames + 1 } else { 0 };
         if *frames == SETTLE_FRAMES {
             saves.write_batch(wanted);
         }

@@ -68,7 +68,7 @@ pub const YEAR_DAYS: usize = 26;
 /// thesis' figure 1.4h), computed in the background when asked for.
 #[derive(Resource, Default)]
 pub struct YearMap {
-    /// Keyed by sensor, year and sky.
+    /// Keyed by sensor, year, sky and site.
     pub map: Background<(usize, i32, String), Vec<Vec<f64>>>,
     /// Days done, for the progress bar.
     done: Arc<AtomicUsize>,
@@ -94,15 +94,17 @@ pub fn update_year_map(
     mut year: ResMut<YearMap>,
 ) {
     year.map.collect();
-    let key = selected.0.map(|s| (s, solar.0.date.year, format!("{:?}", sky.0)));
+    let key = selected.0.map(|s| (s, solar.0.date.year, format!("{:?} {:?}", sky.0, site.as_ref().map(|s| s.0))));
     if year.map.key.is_some() && year.map.key != key && year.map.task.is_none() {
         // What is shown no longer fits the sensor or sky.
         year.map = Background::default();
     }
-    if !std::mem::take(&mut year.requested) {
+    // A request waits for the sensor and the light engine's model.
+    if !year.requested {
         return;
     }
     let (Some(sensor), Some(site), Some(model)) = (selected.0, site, engine.and_then(|e| e.model.clone())) else { return };
+    year.requested = false;
     let (first, spec, site) = (solar.0.date.year, sky.0.clone(), site.0);
     let done = Arc::new(AtomicUsize::new(0));
     year.done = done.clone();
