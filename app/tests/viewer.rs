@@ -1,6 +1,7 @@
 //! The viewer in a window, under Xvfb with Mesa's software Vulkan driver:
-//! `heliodon view SCENE --screenshot FILE --hdr FILE` waits for the light,
-//! saves the window with its panels and the 3D view's luminance, and exits.
+//! `heliodon view SCENE --sensor NAME --screenshot FILE --hdr FILE` waits
+//! for the light and the sensor's day, saves the window with its panels and
+//! the 3D view's luminance, and exits.
 
 use std::path::Path;
 use std::process::Command;
@@ -17,7 +18,7 @@ fn view_screenshot_shows_the_panels_and_the_lit_model() {
     let out = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 1280x800x24", env!("CARGO_BIN_EXE_heliodon"), "view"])
         .arg(&scene)
-        .args(["--date", "2026-03-21", "--time", "10:00", "--screenshot"])
+        .args(["--date", "2026-03-21", "--time", "10:00", "--sensor", "near-window", "--screenshot"])
         .arg(&shot)
         .arg("--hdr")
         .arg(&hdr)

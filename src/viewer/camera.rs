@@ -1,10 +1,11 @@
-//! A CAD-like camera: left-drag orbits about the point under the cursor
-//! where it pressed (the focus moves there; the eye stays), right- or middle-drag
+//! A CAD-like camera: left-drag orbits about the point of the model under
+//! the cursor where it pressed (that point stays put on the screen; a click
+//! without a drag leaves the view alone), right- or middle-drag
 //! pans, the wheel zooms toward the point under the cursor, `F` frames the
 //! whole model. In walk mode (a panel checkbox) W/A/S/D move the eye at its
 //! height and left-drag looks around from it. z is up.
 
-use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll, MouseScrollUnit};
+use bevy::input::mouse::{AccumulatedMouseScroll, MouseScrollUnit};
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
@@ -55,6 +56,19 @@ impl CadCamera {
         self.focus + self.distance * Vec3::new(cp * cy, cp * sy, sp)
     }
 
+    /// Turns the view by `yaw` and `pitch` (radians) about `pivot`, which
+    /// keeps its place in the view (the focus, when `None`; the eye, to look
+    /// around from it).
+    pub fn orbit(&mut self, yaw: f32, pitch: f32, pivot: Option<Vec3>) {
+        let before = self.transform().rotation;
+        self.yaw += yaw;
+        self.pitch = (self.pitch + pitch).clamp(-MAX_PITCH, MAX_PITCH);
+        if let Some(pivot) = pivot {
+            let turn = self.transform().rotation * before.inverse();
+            self.focus = pivot + turn * (self.focus - pivot);
+        }
+    }
+
     pub fn transform(&self) -> Transform {
         Transform::from_translation(self.eye()).looking_at(self.focus, Vec3::Z)
     }
@@ -64,7 +78,6 @@ impl CadCamera {
 pub fn navigate(
     mouse: Res<ButtonInput<MouseButton>>,
     keys: Res<ButtonInput<KeyCode>>,
-    motion: Res<AccumulatedMouseMotion>,
     scroll: Res<AccumulatedMouseScroll>,
     window: Single<&Window, With<PrimaryWindow>>,
     active: Res<ActiveScene>,
@@ -73,9 +86,15 @@ pub fn navigate(
     time: Res<Time>,
     mut cameras: Query<(&mut CadCamera, &mut Transform, &Camera, &GlobalTransform, &Projection)>,
     mut drag_in_view: Local<bool>,
+    mut pivot: Local<Option<Vec3>>,
+    mut last_cursor: Local<Option<Vec2>>,
 ) {
-    let over_panels = ui.as_ref().is_some_and(|ui| ui.pointer_over_panels);
-    let walking = ui.is_some_and(|ui| ui.walk);
+    // Drags follow the cursor across the window (raw mouse motion is not
+    // there on every system: remote desktops, Xvfb).
+    let moved = window.cursor_position().zip(*last_cursor).map_or(Vec2::ZERO, |(now, before)| now - before);
+    *last_cursor = window.cursor_position();
+    let over_panels = ui.as_ref().zip(window.cursor_position()).is_some_and(|(ui, cursor)| ui.over_panels(cursor));
+    let walking = ui.as_ref().is_some_and(|ui| ui.walk);
     let buttons = [MouseButton::Left, MouseButton::Right, MouseButton::Middle];
     for (mut cad, mut transform, camera, global, projection) in &mut cameras {
         let fov = match projection {
@@ -92,31 +111,25 @@ pub fn navigate(
         } else if !mouse.any_pressed(buttons) {
             *drag_in_view = false;
         }
-        let delta = if *drag_in_view { motion.delta } else { Vec2::ZERO };
+        let delta = if *drag_in_view { moved } else { Vec2::ZERO };
         let cursor_ray = cursor.and_then(|cursor| camera.viewport_to_world(global, cursor).ok());
         if over_panels && !*drag_in_view {
             // Keys typed into a panel are not for the camera either.
             *transform = cad.transform();
             continue;
         }
-        if mouse.just_pressed(MouseButton::Left)
-            && !walking
-            && let (Some(ray), Some(model)) = (cursor_ray, ray_model.as_ref())
-            && let Some((_, distance)) = model.0.trace(ray.origin.as_dvec3(), ray.direction.as_vec3().as_dvec3())
-        {
-            // Orbit about the point under the cursor.
-            let eye = cad.eye();
-            *cad = CadCamera::looking(eye, ray.origin + ray.direction * distance as f32);
+        if mouse.just_pressed(MouseButton::Left) {
+            // The point of the model under the cursor (none off the model:
+            // then the orbit is about the focus).
+            *pivot = cursor_ray.zip(ray_model.as_ref()).and_then(|(ray, model)| {
+                let (_, distance) = model.0.trace(ray.origin.as_dvec3(), ray.direction.as_vec3().as_dvec3())?;
+                Some(ray.origin + ray.direction * distance as f32)
+            });
         }
         if mouse.pressed(MouseButton::Left) && delta != Vec2::ZERO {
-            let eye = cad.eye();
-            cad.yaw -= delta.x * ORBIT_SPEED;
-            cad.pitch = (cad.pitch + delta.y * ORBIT_SPEED).clamp(-MAX_PITCH, MAX_PITCH);
-            if walking {
-                // Look around from the eye: the focus moves, the eye stays.
-                let look = cad.eye() - cad.focus;
-                cad.focus = eye - look;
-            }
+            // Walking looks around from the eye; otherwise orbit the pivot.
+            let pivot = if walking { Some(cad.eye()) } else { *pivot };
+            cad.orbit(-delta.x * ORBIT_SPEED, delta.y * ORBIT_SPEED, pivot);
         }
         if walking {
             let (sin, cos) = cad.yaw.sin_cos();
@@ -166,16 +179,12 @@ pub fn navigate(
     }
 }
 
-/// The cursor in `camera`'s viewport coordinates, when it is inside the
-/// viewport (the panels shift and narrow it).
+/// The cursor, when it is inside `camera`'s viewport (the panels shift and
+/// narrow it). Window coordinates, as Bevy's viewport conversions take and
+/// give them.
 pub fn cursor_in_view(window: &Window, camera: &Camera) -> Option<Vec2> {
     let cursor = window.cursor_position()?;
-    let (offset, size) = match &camera.viewport {
-        Some(v) => (v.physical_position.as_vec2() / window.scale_factor(), v.physical_size.as_vec2() / window.scale_factor()),
-        None => (Vec2::ZERO, Vec2::new(window.width(), window.height())),
-    };
-    let local = cursor - offset;
-    (local.cmpge(Vec2::ZERO).all() && local.cmplt(size).all()).then_some(local)
+    camera.logical_viewport_rect().filter(|rect| rect.contains(cursor)).map(|_| cursor)
 }
 
 #[cfg(test)]
@@ -188,5 +197,23 @@ mod tests {
         let target = Vec3::new(1.0, 2.0, 0.5);
         let cad = CadCamera::looking(eye, target);
         assert!((cad.eye() - eye).length() < 1e-4);
+    }
+
+    #[test]
+    fn orbiting_keeps_the_pivot_in_place_in_the_view() {
+        let in_view = |cad: &CadCamera, p: Vec3| cad.transform().compute_affine().inverse().transform_point3(p);
+        let mut cad = CadCamera::looking(Vec3::new(-3.0, -4.0, 2.5), Vec3::new(1.0, 2.0, 0.5));
+        let pivot = Vec3::new(2.0, 1.0, 0.0);
+        let before = in_view(&cad, pivot);
+        cad.orbit(0.3, -0.2, Some(pivot));
+        assert!((in_view(&cad, pivot) - before).length() < 1e-4, "{} vs {before}", in_view(&cad, pivot));
+        // Looking around from the eye keeps the eye.
+        let eye = cad.eye();
+        cad.orbit(-0.5, 0.1, Some(eye));
+        assert!((cad.eye() - eye).length() < 1e-4);
+        // About the focus: the focus stays.
+        let focus = cad.focus;
+        cad.orbit(0.4, 0.0, None);
+        assert_eq!(cad.focus, focus);
     }
 }

@@ -144,10 +144,9 @@ pub fn draw_markers(
         let (Some(reading), Ok(screen)) = (readings.and_then(|r| r.get(i)), camera.world_to_viewport(transform, p)) else { continue };
         // Labels for the chosen sensor and, to keep the view readable, for a few.
         if chosen || scene.sensors.len() <= 12 {
-            let scale = ctx.pixels_per_point();
-            let offset = camera.viewport.as_ref().map_or(Vec2::ZERO, |v| v.physical_position.as_vec2() / scale);
+            // Viewport conversions give window coordinates, as egui places areas.
             bevy_egui::egui::Area::new(bevy_egui::egui::Id::new(("sensor", i)))
-                .fixed_pos(bevy_egui::egui::pos2(screen.x + offset.x + 6.0, screen.y + offset.y - 18.0))
+                .fixed_pos(bevy_egui::egui::pos2(screen.x + 6.0, screen.y - 18.0))
                 .interactable(false)
                 .show(&ctx, |ui| {
                     ui.label(bevy_egui::egui::RichText::new(format!("{} {:.0} lx", sensor.name, reading.total)).small().background_color(bevy_egui::egui::Color32::from_black_alpha(160)));
@@ -169,7 +168,7 @@ pub fn pick_sensor(
 ) {
     let (Some(scene), Ok((camera, transform))) = (&active.scene, camera.single()) else { return };
     // A click in the view, off the panels, that does not move.
-    let cursor = super::camera::cursor_in_view(&window, camera).filter(|_| !ui.pointer_over_panels);
+    let cursor = window.cursor_position().filter(|c| !ui.over_panels(*c)).and_then(|_| super::camera::cursor_in_view(&window, camera));
     if mouse.just_pressed(MouseButton::Left) {
         *pressed_at = cursor;
     }

@@ -65,8 +65,10 @@ impl Plugin for DesignerUiPlugin {
 pub struct UiState {
     /// The day plays: hours of solar time per second.
     pub playing: Option<f64>,
-    /// Whether the pointer is over a panel (the camera then ignores it).
+    /// Whether the pointer is over a panel (the camera then ignores it), as
+    /// egui saw it at `pointer_checked_at`; see [`UiState::over_panels`].
     pub pointer_over_panels: bool,
+    pub pointer_checked_at: Option<Vec2>,
     /// Last clamped input or saved file, shown until the next one.
     pub note: Option<String>,
     /// Views the user saved this session.
@@ -80,6 +82,16 @@ pub struct UiState {
     pub save_image: Option<ImageFormat>,
     /// What the materials panel is editing.
     pub materials: MaterialEdits,
+}
+
+impl UiState {
+    /// Whether the pointer at `cursor` is over a panel. egui's answer is a
+    /// frame old: it counts only where the pointer has not moved since (a
+    /// pointer that jumped into the view and clicked in one frame is in the
+    /// view; the side panels are outside the view's viewport anyway).
+    pub fn over_panels(&self, cursor: Vec2) -> bool {
+        self.pointer_over_panels && self.pointer_checked_at.is_some_and(|p| p.distance(cursor) < 0.5)
+    }
 }
 
 /// The files the view can be saved as.
@@ -207,6 +219,7 @@ fn panels(
         .rect
         .width();
     ui_state.pointer_over_panels = ctx.is_pointer_over_egui();
+    ui_state.pointer_checked_at = window.cursor_position();
     // The 3D view: what the panels leave.
     let scale = window.scale_factor();
     let (left, right) = ((left * scale) as u32, (right * scale) as u32);
