@@ -105,7 +105,60 @@ fn bench(c: &mut Criterion) {
         println!("{label}: {counts}");
         group.bench_function(format!("frame {label} {WIDTH}x{HEIGHT}"), |b| b.iter(|| app.update()));
     }
+    settling(&mut group);
     group.finish();
+}
+
+/// The office while its light settles: frames drawn while relights run
+/// (each converged relight is followed by a new time, ten minutes on), and
+/// the frames around a material edit (respawn and a new precomputation).
+fn settling(group: &mut criterion::BenchmarkGroup<criterion::measurement::WallTime>) {
+    use heliodon::ecs::{ActiveScene, EditMaterial, LightingState, SolarTime};
+    use std::time::Instant;
+    let (mut app, _) = ready_app(heliodon::bundled_scene("office"), RenderMode::Full);
+    let converged = |app: &App| app.world().get_resource::<LightingState>().is_some_and(|l| l.converged);
+    let mut relights = 0u32;
+    group.bench_function(format!("frame office full while the light settles {WIDTH}x{HEIGHT}"), |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            for _ in 0..iters {
+                if converged(&app) {
+                    let mut time = app.world_mut().resource_mut::<SolarTime>();
+                    let minutes = (time.0.time.hours() * 60.0 + 10.0).rem_euclid(8.0 * 60.0) + 8.0 * 60.0;
+                    time.0.time = TimeOfDay::from_hours(minutes / 60.0).unwrap();
+                    relights += 1;
+                }
+                let start = Instant::now();
+                app.update();
+                total += start.elapsed();
+            }
+            total
+        })
+    });
+    println!("{relights} relights started while measuring");
+    // One glass edit: the frames until the light has converged again.
+    let scene = app.world().resource::<ActiveScene>().scene.clone().unwrap();
+    let index = scene.materials.iter().position(|m| m.name == "upper_glass").unwrap() as u32;
+    app.world_mut().write_message(EditMaterial { index, kind: heliodon::scene::MaterialKind::Glass { transmittance: 0.5 } });
+    let mut frames = Vec::new();
+    let start = Instant::now();
+    while frames.is_empty() || !converged(&app) || frames.len() < 3 {
+        let frame = Instant::now();
+        app.update();
+        frames.push(frame.elapsed().as_secs_f64() * 1e3);
+    }
+    let worst = frames.iter().copied().fold(0.0, f64::max);
+    let median = {
+        let mut sorted = frames.clone();
+        sorted.sort_by(f64::total_cmp);
+        sorted[sorted.len() / 2]
+    };
+    println!(
+        "office, upper_glass edited: light back after {:.2} s and {} frames; frame median {median:.0} ms, worst {worst:.0} ms (frame 1: {:.0} ms)",
+        start.elapsed().as_secs_f64(),
+        frames.len(),
+        frames[0]
+    );
 }
 
 criterion_group!(benches, bench);
