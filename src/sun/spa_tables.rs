@@ -3,6 +3,9 @@
 //! and radius R: rows of A, B, C for A·cos(B + C·JME)) and table A4.3
 //! (nutation: multiples of X0..X4, and a, b, c, d).
 
+// Phases such as 3.14 and 3.142 are the published terms, not π.
+#![allow(clippy::approx_constant)]
+
 pub const L0: [[f64; 3]; 64] = [
     [175347046.0, 0.0, 0.0],
     [3341656.0, 4.6692568, 6283.07585],

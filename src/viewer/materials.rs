@@ -240,8 +240,7 @@ fn key_widget(ui: &mut Ui, key: &Key, values: &mut toml::Table, files: &[String]
     let number = |v: &toml::Value| v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
     let given = values.get(key.name).cloned();
     let label = format!("{} ", key.name);
-    let committed_change = ui
-        .horizontal(|ui| match key.kind {
+    ui.horizontal(|ui| match key.kind {
             KeyKind::Number { range, default } => {
                 let mut v = given.as_ref().and_then(number).unwrap_or(default);
                 let response = bounded(ui, &mut v, range.0..=range.1, (range.1 - range.0) / 500.0, &label, "", note).on_hover_text(key.help);
@@ -280,9 +279,8 @@ fn key_widget(ui: &mut Ui, key: &Key, values: &mut toml::Table, files: &[String]
                 values.insert(key.name.into(), toml::Value::String(file));
                 commit
             }
-        })
-        .inner;
-    committed_change
+    })
+    .inner
 }
 
 impl MaterialEdits {

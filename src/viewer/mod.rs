@@ -160,6 +160,7 @@ const SETTLE_FRAMES: u32 = 10;
 
 /// Saves the window (and the view's luminance) once the light has
 /// converged, then exits.
+#[allow(clippy::too_many_arguments)]
 fn take_screenshot(
     request: Option<Res<ViewStart>>,
     lighting: Option<Res<crate::ecs::LightingState>>,

@@ -236,6 +236,7 @@ fn panels(
 
 // Resources are passed as `ResMut` and written only when a value changes:
 // writing marks them changed, and a changed time or sky starts a relight.
+#[allow(clippy::too_many_arguments)]
 fn sun_and_sky_panel(
     ui: &mut Ui,
     state: &mut UiState,
