@@ -12,7 +12,7 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy_egui::egui::{self, Ui};
 
-use super::ui::bounded;
+use super::ui::{bounded, clamp_noted};
 use crate::ecs::{EditMaterial, MaterialEditRejected, PanelRegistry};
 use crate::panel::{Key, KeyKind, PanelCatalog, Parameters, default_values};
 use crate::scene::{MaterialKind, Rgb, Scene};
@@ -128,7 +128,7 @@ pub fn material_panel(ui: &mut Ui, edits: &mut MaterialEdits, note: &mut Option<
                     ui.label(&material.name);
                     let mut changed = false;
                     for (c, label) in ["R ", "G ", "B "].iter().enumerate() {
-                        changed |= committed(&ui.add(egui::DragValue::new(&mut rgb[c]).range(0.0..=1.0).speed(0.005).prefix(*label)));
+                        changed |= committed(&bounded(ui, &mut rgb[c], 0.0..=1.0, 0.005, label, "", note));
                     }
                     changed
                 })
@@ -192,7 +192,9 @@ fn window_material(
     match kind {
         MaterialKind::Glass { transmittance } => {
             let mut t = *transmittance;
-            committed(&ui.add(egui::Slider::new(&mut t, 0.0..=1.0).text("transmittance"))).then_some(MaterialKind::Glass { transmittance: t })
+            let response = ui.add(egui::Slider::new(&mut t, 0.0..=1.0).text("transmittance").clamping(egui::SliderClamping::Never));
+            clamp_noted(&mut t, 0.0..=1.0, "transmittance ", "", note);
+            committed(&response).then_some(MaterialKind::Glass { transmittance: t })
         }
         MaterialKind::Panel { panel, up, parameters, .. } => {
             let keys = catalog.get(panel).map(|p| p.keys()).unwrap_or_default();
@@ -263,7 +265,7 @@ fn key_widget(ui: &mut Ui, key: &Key, values: &mut toml::Table, files: &[String]
             }
             KeyKind::Count { range, default } => {
                 let mut v = given.as_ref().and_then(toml::Value::as_integer).unwrap_or(default);
-                let response = ui.add(egui::DragValue::new(&mut v).range(range.0..=range.1).prefix(&label)).on_hover_text(key.help);
+                let response = bounded(ui, &mut v, range.0..=range.1, 0.05, &label, "", note).on_hover_text(key.help);
                 values.insert(key.name.into(), toml::Value::Integer(v));
                 committed(&response)
             }

@@ -17,6 +17,9 @@ use bevy_egui::egui::{self, LayerId, Ui, UiBuilder};
 use bevy_egui::{EguiContexts, EguiGlobalSettings, EguiPlugin, EguiPrimaryContextPass, PrimaryEguiContext};
 
 use bevy::ecs::system::SystemParam;
+use bevy_egui::egui::emath::Numeric;
+use std::fmt::Display;
+use std::ops::RangeInclusive;
 use std::path::PathBuf;
 
 use super::camera::CadCamera;
@@ -253,16 +256,16 @@ fn sun_and_sky_panel(
     let days = if days_in_month(date.year, 2) == 29 { 366 } else { 365 };
     let mut day = date.day_of_year();
     ui.label(format!("Date: {date}"));
-    if ui.add(egui::Slider::new(&mut day, 1..=days).text("day of year")).changed() {
+    if slider(ui, &mut day, 1..=days, "day of year", &mut state.note).changed() {
         date = Date::new(date.year, 1, 1).expect("1 January").add_days(i64::from(day) - 1);
     }
     ui.horizontal(|ui| {
         let mut year = date.year;
         let mut month = date.month;
         let mut day = date.day;
-        let y = ui.add(egui::DragValue::new(&mut year).range(1900..=2100)).changed();
-        let m = ui.add(egui::DragValue::new(&mut month).range(1..=12)).changed();
-        let d = ui.add(egui::DragValue::new(&mut day).range(1..=31)).changed();
+        let y = bounded(ui, &mut year, 1900..=2100, 0.1, "year ", "", &mut state.note).changed();
+        let m = bounded(ui, &mut month, 1..=12, 0.05, "month ", "", &mut state.note).changed();
+        let d = bounded(ui, &mut day, 1..=31, 0.05, "day ", "", &mut state.note).changed();
         if y || m || d {
             let last = days_in_month(year, month);
             if day > last {
@@ -282,23 +285,26 @@ fn sun_and_sky_panel(
         }
     });
     let mut minutes = (time.hours() * 60.0).round() as i64;
-    ui.add(egui::Slider::new(&mut minutes, 0..=1439).text("time").custom_formatter(|m, _| format!("{:02}:{:02}", m as i64 / 60, m as i64 % 60)));
+    let clock = |m: f64, _: std::ops::RangeInclusive<usize>| format!("{:02}:{:02}", m as i64 / 60, m as i64 % 60);
+    ui.add(egui::Slider::new(&mut minutes, 0..=1439).text("time").custom_formatter(clock).clamping(egui::SliderClamping::Never));
     ui.horizontal(|ui| {
         ui.label("exact");
         ui.add(
-            egui::DragValue::new(&mut minutes)
-                .range(0..=1439)
-                .custom_formatter(|m, _| format!("{:02}:{:02}", m as i64 / 60, m as i64 % 60))
-                .custom_parser(|text| {
-                    let (h, m) = text.split_once(':')?;
-                    Some((h.trim().parse::<f64>().ok()? * 60.0 + m.trim().parse::<f64>().ok()?).clamp(0.0, 1439.0))
-                }),
+            egui::DragValue::new(&mut minutes).custom_formatter(clock).custom_parser(|text| {
+                let (h, m) = text.split_once(':')?;
+                Some(h.trim().parse::<f64>().ok()? * 60.0 + m.trim().parse::<f64>().ok()?)
+            }),
         );
         let label = if state.playing.is_some() { "Pause" } else { "Play the day" };
         if ui.button(label).clicked() {
             state.playing = if state.playing.is_some() { None } else { Some(0.5) };
         }
     });
+    if !(0..=1439).contains(&minutes) {
+        let clamped = minutes.clamp(0, 1439);
+        state.note = Some(format!("time {}:{:02} is outside 00:00..23:59: {:02}:{:02} is used", minutes.div_euclid(60), minutes.rem_euclid(60), clamped / 60, clamped % 60));
+        minutes = clamped;
+    }
     let time = TimeOfDay::from_hours(minutes as f64 / 60.0).unwrap_or(time);
     let new = LocalDateTime { date, time };
     if new != solar.0 {
@@ -338,7 +344,7 @@ fn sun_and_sky_panel(
     let mut ev = settings.exposure.unwrap_or(10.0);
     ui.horizontal(|ui| {
         ui.checkbox(&mut auto, "auto exposure");
-        ui.add_enabled(!auto, egui::Slider::new(&mut ev, -5.0..=20.0).text("EV"));
+        ui.add_enabled_ui(!auto, |ui| slider(ui, &mut ev, -5.0..=20.0, "EV", &mut state.note));
     });
     let exposure = if auto { None } else { Some(ev) };
     if exposure != settings.exposure {
@@ -351,14 +357,29 @@ fn sun_and_sky_panel(
 
 /// A number field: what is typed outside `range` is clamped into it, with a
 /// note saying so (never a panic, never a silent change).
-pub(super) fn bounded(ui: &mut Ui, value: &mut f64, range: std::ops::RangeInclusive<f64>, speed: f64, prefix: &str, suffix: &str, note: &mut Option<String>) -> egui::Response {
+pub(super) fn bounded<N: Numeric + Display>(ui: &mut Ui, value: &mut N, range: RangeInclusive<N>, speed: f64, prefix: &str, suffix: &str, note: &mut Option<String>) -> egui::Response {
     let response = ui.add(egui::DragValue::new(value).speed(speed).prefix(prefix).suffix(suffix));
-    if !range.contains(value) {
-        let clamped = if value.is_nan() { *range.start() } else { value.clamp(*range.start(), *range.end()) };
-        *note = Some(format!("{}{value}{suffix} is outside {}..{}: {clamped} is used", prefix.trim_start(), range.start(), range.end()));
-        *value = clamped;
-    }
+    clamp_noted(value, range, prefix.trim_start(), suffix, note);
     response
+}
+
+/// A slider for browsing; a value typed into its box outside `range` is
+/// clamped with a note, as in [`bounded`].
+fn slider<N: Numeric + Display>(ui: &mut Ui, value: &mut N, range: RangeInclusive<N>, text: &str, note: &mut Option<String>) -> egui::Response {
+    let response = ui.add(egui::Slider::new(value, range.clone()).text(text).clamping(egui::SliderClamping::Never));
+    clamp_noted(value, range, &format!("{text} "), "", note);
+    response
+}
+
+/// Clamps `value` into `range`; when it was outside, says so in `note`.
+pub(super) fn clamp_noted<N: Numeric + Display>(value: &mut N, range: RangeInclusive<N>, what: &str, suffix: &str, note: &mut Option<String>) {
+    let (v, lo, hi) = (value.to_f64(), range.start().to_f64(), range.end().to_f64());
+    if (lo..=hi).contains(&v) {
+        return;
+    }
+    let clamped = if v.is_nan() || v < lo { *range.start() } else { *range.end() };
+    *note = Some(format!("{what}{value}{suffix} is outside {}..{}: {clamped} is used", range.start(), range.end()));
+    *value = clamped;
 }
 
 /// A map-free sun-path diagram: today's arc (altitude against azimuth, the
@@ -419,14 +440,14 @@ fn sky_controls(ui: &mut Ui, sky: &mut ResMut<SkyChoice>, note: &mut Option<Stri
     }
     match &mut spec {
         SkySpec::Clear { turbidity } | SkySpec::Intermediate { turbidity } => {
-            ui.add(egui::Slider::new(turbidity, 1.0..=10.0).text("turbidity"));
+            slider(ui, turbidity, 1.0..=10.0, "turbidity", note);
         }
         SkySpec::Perez(perez::Input::Irradiance { direct_normal, diffuse_horizontal }) => {
             bounded(ui, direct_normal, 0.0..=1100.0, 1.0, "DNI ", " W/m²", note);
             bounded(ui, diffuse_horizontal, 1.0..=600.0, 1.0, "DHI ", " W/m²", note);
         }
         SkySpec::Cie { standard_type, diffuse_illuminance, direct_illuminance } => {
-            ui.add(egui::Slider::new(standard_type, 1..=15).text("CIE type"));
+            slider(ui, standard_type, 1..=15, "CIE type", note);
             bounded(ui, diffuse_illuminance, 100.0..=60_000.0, 50.0, "diffuse ", " lx", note);
             bounded(ui, direct_illuminance, 0.0..=120_000.0, 100.0, "direct ", " lx", note);
         }
@@ -451,7 +472,7 @@ fn view_panel(ui: &mut Ui, state: &mut UiState, settings: &mut ResMut<RenderSett
     }
     if settings.mode == RenderMode::FalseColour {
         let mut top = settings.false_colour_max_lux;
-        ui.add(egui::DragValue::new(&mut top).range(10.0..=200_000.0).prefix("scale top ").suffix(" lx"));
+        bounded(ui, &mut top, 10.0..=200_000.0, 10.0, "scale top ", " lx", &mut state.note);
         if top != settings.false_colour_max_lux {
             settings.false_colour_max_lux = top;
         }
@@ -702,5 +723,15 @@ mod tests {
         output.textures_delta.clear();
         assert_eq!((ok, latitude), (42.0, 90.0));
         assert_eq!(note.as_deref(), Some("lat 123 is outside -90..90: 90 is used"));
+        // Whole numbers and the boxes of sliders likewise.
+        let (mut month, mut ev, mut month_note, mut ev_note) = (13u32, 30.0f32, None, None);
+        let mut output = ctx.run_ui(egui::RawInput::default(), |ui| {
+            bounded(ui, &mut month, 1..=12, 0.05, "month ", "", &mut month_note);
+            slider(ui, &mut ev, -5.0..=20.0, "EV", &mut ev_note);
+        });
+        output.textures_delta.clear();
+        assert_eq!((month, ev), (12, 20.0));
+        assert_eq!(month_note.as_deref(), Some("month 13 is outside 1..12: 12 is used"));
+        assert_eq!(ev_note.as_deref(), Some("EV 30 is outside -5..20: 20 is used"));
     }
 }
