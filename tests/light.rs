@@ -95,6 +95,37 @@ fn turning_north_on_the_site_matches_turning_the_model_in_its_file() {
     assert!(largest_change > 0.2, "turning north changed the light by {largest_change}");
 }
 
+/// Windows given a material of their own (the designer's "own material" on
+/// a window group) change alone: a copy changes nothing, and closing the
+/// copy leaves the other panes lighting the room.
+#[test]
+fn windows_given_their_own_material_change_alone() {
+    use heliodon::scene::MaterialKind;
+    let scene = load(&sideroom());
+    let sky = sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "12:00");
+    let solve = |scene: Scene| LightModel::precompute(Arc::new(scene), quick()).unwrap().solve(&sky, None).sensors;
+    let before = solve((*scene).clone());
+    let mut split = (*scene).clone();
+    let wall = split.surfaces.iter().position(|s| !split.material(s.material).kind.transmits()).unwrap() as u32;
+    let panes: Vec<u32> = split.windows.iter().take(3).map(|w| w.surface).collect();
+    assert_eq!(split.give_own_material(&[panes[0], wall], "mixed".into()), None, "surfaces of two materials");
+    let own = split.give_own_material(&panes, "three panes".into()).unwrap();
+    assert_eq!(split.windows.iter().filter(|w| w.material == own).count(), 3);
+    assert!(split.patches.patches.iter().filter(|p| p.material == own).all(|p| panes.contains(&p.surface)));
+    assert!(split.triangles.iter().filter(|t| t.material == own).count() >= 3);
+    let copied = solve(split.clone());
+    for (a, b) in before.iter().zip(&copied) {
+        assert!((a.total - b.total).abs() <= 1e-9 * a.total.max(1.0), "{a:?} {b:?}");
+    }
+    split.materials[own as usize].kind = MaterialKind::Glass { transmittance: 0.0 };
+    let closed = solve(split);
+    let sky_of = |readings: &[heliodon::light::SensorReading]| readings.iter().map(|r| r.direct_sky).sum::<f64>();
+    let share = sky_of(&closed) / sky_of(&before);
+    println!("three of six panes closed: {:.1}% of the direct sky left", 100.0 * share);
+    assert!((0.2..0.8).contains(&share), "{share}");
+    assert!(closed.iter().all(|r| r.total > 0.0));
+}
+
 fn quick() -> LightSettings {
     LightSettings { rays_per_patch: 64, rays_per_sensor: 512, sun_samples_per_patch: 4, area_sensor_sun_grid: 4, ..Default::default() }
 }

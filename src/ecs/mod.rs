@@ -14,7 +14,7 @@ use bevy::prelude::*;
 
 pub use scene_asset::{AddPanels, PanelRegistry, RegisterPanel, SceneAsset, panel_catalog, SceneLoader, describe_load_failure, scene_asset_path};
 pub use scene_plugin::{
-    ActiveScene, EditMaterial, MaterialEditRejected, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, ScenePlugin, SceneRoot, SceneSpawned,
+    ActiveScene, EditMaterial, GiveOwnMaterial, MaterialEditRejected, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, ScenePlugin, SceneRoot, SceneSpawned,
     SceneSurface, SceneSensor, SceneWindow, Site,
 };
 pub use lighting::{LightCacheDir, LightEngine, LightingFailed, LightingPlugin, LightingSettings, LightingState, LightingUpdated};

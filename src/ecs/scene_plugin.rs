@@ -1,6 +1,7 @@
 //! [`ScenePlugin`]: opens scene files ([`OpenScene`]), and once loaded
 //! replaces the scene's entities: one per material, surface, window and
-//! sensor, under one [`SceneRoot`], and the [`Site`] resource.
+//! sensor, under one [`SceneRoot`], and the [`Site`] resource. Materials
+//! are edited at run time ([`EditMaterial`], [`GiveOwnMaterial`]).
 
 use std::ops::{Deref, Range};
 use std::path::PathBuf;
@@ -25,6 +26,7 @@ impl Plugin for ScenePlugin {
             .add_message::<SceneSpawned>()
             .add_message::<SceneLoadFailed>()
             .add_message::<EditMaterial>()
+            .add_message::<GiveOwnMaterial>()
             .add_message::<MaterialEditRejected>()
             .configure_sets(
                 Update,
@@ -60,6 +62,15 @@ pub struct SceneSpawned {
 pub struct EditMaterial {
     pub index: u32,
     pub kind: scene::MaterialKind,
+}
+
+/// Give some surfaces (a group of windows) a material of their own, a copy
+/// of the one they share with others, so it can be edited alone
+/// ([`Scene::give_own_material`]). The scene is spawned again.
+#[derive(Message, Debug, Clone)]
+pub struct GiveOwnMaterial {
+    pub surfaces: Vec<u32>,
+    pub name: String,
 }
 
 /// An edit that cannot apply (a diffuse material made a window, or the
@@ -178,16 +189,23 @@ fn spawn_loaded_scene(
 fn apply_material_edits(
     mut commands: Commands,
     mut edits: MessageReader<EditMaterial>,
+    mut splits: MessageReader<GiveOwnMaterial>,
     mut active: ResMut<ActiveScene>,
     mut spawned: MessageWriter<SceneSpawned>,
     mut rejected: MessageWriter<MaterialEditRejected>,
 ) {
     let edits: Vec<EditMaterial> = edits.read().cloned().collect();
-    if edits.is_empty() {
+    let splits: Vec<GiveOwnMaterial> = splits.read().cloned().collect();
+    if edits.is_empty() && splits.is_empty() {
         return;
     }
     let Some(current) = active.scene.clone() else { return };
     let mut scene = (*current).clone();
+    for split in splits {
+        if scene.give_own_material(&split.surfaces, split.name.clone()).is_none() {
+            rejected.write(MaterialEditRejected { message: format!("'{}': the surfaces given do not share one material", split.name) });
+        }
+    }
     for edit in edits {
         let Some(material) = scene.materials.get_mut(edit.index as usize) else { continue };
         if material.kind.transmits() != edit.kind.transmits() {

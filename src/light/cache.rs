@@ -72,13 +72,18 @@ pub fn key(scene: &Scene, settings: &LightSettings) -> std::io::Result<u64> {
         hash.u64(data.len() as u64).bytes(&data);
     }
     // Materials edited at run time: what the gathers depend on (which
-    // materials pass light, and glass transmittance; not reflectances).
+    // materials pass light, and glass transmittance; not reflectances), and
+    // which surfaces have which.
     for material in &scene.materials {
         match &material.kind {
             MaterialKind::Diffuse { .. } => hash.u64(0),
             MaterialKind::Glass { transmittance } => hash.u64(1).u64(u64::from(transmittance.to_bits())),
             MaterialKind::Panel { .. } => hash.u64(2),
         };
+    }
+    // Surfaces given materials of their own at run time.
+    for surface in &scene.surfaces {
+        hash.u64(u64::from(surface.material));
     }
     hash.u64(settings.rays_per_patch as u64)
         .u64(settings.rays_per_sensor as u64)

@@ -256,4 +256,33 @@ impl Scene {
     pub fn window_area(&self) -> f32 {
         self.windows.iter().map(|w| w.area).sum()
     }
+
+    /// Gives `surfaces` (say, the windows of one façade) a material of their
+    /// own: a copy of the one the first of them has, named `name`, so it can
+    /// be changed without touching the others that shared it. Their
+    /// triangles, patches and windows follow. Returns the new material's
+    /// index; `None` when `surfaces` is empty, out of range or of more than
+    /// one material.
+    pub fn give_own_material(&mut self, surfaces: &[u32], name: String) -> Option<u32> {
+        let material = self.surfaces.get(*surfaces.first()? as usize)?.material;
+        if surfaces.iter().any(|&s| self.surfaces.get(s as usize).is_none_or(|s| s.material != material)) {
+            return None;
+        }
+        let new = self.materials.len() as u32;
+        self.materials.push(Material { name, ..self.materials[material as usize].clone() });
+        for &index in surfaces {
+            let surface = &mut self.surfaces[index as usize];
+            surface.material = new;
+            for triangle in &mut self.triangles[surface.triangles.start as usize..surface.triangles.end as usize] {
+                triangle.material = new;
+            }
+            for patch in &mut self.patches.patches[surface.patches.start as usize..surface.patches.end as usize] {
+                patch.material = new;
+            }
+        }
+        for window in self.windows.iter_mut().filter(|w| surfaces.contains(&w.surface)) {
+            window.material = new;
+        }
+        Some(new)
+    }
 }

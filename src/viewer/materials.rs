@@ -1,9 +1,10 @@
 //! The materials panel: every group of windows (panes of one material
 //! facing one way) with its material, plain glass or any registered panel
-//! with one widget per key the panel declares; and the reflectances of the
-//! opaque materials. Every change sends [`EditMaterial`] (the scene is
-//! respawned and relit); a panel whose keys do not build keeps the material
-//! it had, and the panel says why.
+//! with one widget per key the panel declares; a group that shares its
+//! material can take a copy of its own ([`GiveOwnMaterial`]); and the
+//! reflectances of the opaque materials. Every change sends
+//! [`EditMaterial`] (the scene is respawned and relit); a panel whose keys
+//! do not build keeps the material it had, and the panel says why.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -13,7 +14,7 @@ use bevy::prelude::*;
 use bevy_egui::egui::{self, Ui};
 
 use super::ui::{bounded, clamp_noted};
-use crate::ecs::{EditMaterial, MaterialEditRejected, PanelRegistry};
+use crate::ecs::{EditMaterial, GiveOwnMaterial, MaterialEditRejected, PanelRegistry};
 use crate::panel::{Key, KeyKind, PanelCatalog, Parameters, default_values};
 use crate::scene::{MaterialKind, Rgb, Scene};
 
@@ -46,6 +47,7 @@ struct PendingKeys {
 pub struct MaterialPanel<'w, 's> {
     registry: Option<Res<'w, PanelRegistry>>,
     edits: MessageWriter<'w, EditMaterial>,
+    splits: MessageWriter<'w, GiveOwnMaterial>,
     rejected: MessageReader<'w, 's, MaterialEditRejected>,
 }
 
@@ -59,6 +61,8 @@ pub struct WindowGroup {
     pub panes: usize,
     /// m².
     pub area: f64,
+    /// The panes' surfaces (indices into [`Scene::surfaces`]).
+    pub surfaces: Vec<u32>,
 }
 
 /// The scene's windows grouped by material and facing, in material order.
@@ -82,8 +86,9 @@ pub fn window_groups(scene: &Scene, north_turn: f64) -> Vec<WindowGroup> {
             Some(group) => {
                 group.panes += 1;
                 group.area += f64::from(window.area);
+                group.surfaces.push(window.surface);
             }
-            None => groups.push(WindowGroup { material: window.material, facing, panes: 1, area: f64::from(window.area) }),
+            None => groups.push(WindowGroup { material: window.material, facing, panes: 1, area: f64::from(window.area), surfaces: vec![window.surface] }),
         }
     }
     groups.sort_by_key(|g| g.material);
@@ -106,8 +111,16 @@ pub fn material_panel(ui: &mut Ui, edits: &mut MaterialEdits, note: &mut Option<
             }
             shown.push(group.material);
             let material = &scene.materials[group.material as usize];
-            for g in groups.iter().filter(|g| g.material == group.material) {
-                ui.label(format!("{} windows: {} panes, {:.1} m²", g.facing, g.panes, g.area));
+            let sharing: Vec<&WindowGroup> = groups.iter().filter(|g| g.material == group.material).collect();
+            for g in &sharing {
+                ui.horizontal(|ui| {
+                    ui.label(format!("{} windows: {} panes, {:.1} m²", g.facing, g.panes, g.area));
+                    // A group sharing its material can take one of its own, to be changed alone.
+                    if sharing.len() > 1 && ui.small_button("own material").on_hover_text("give these windows a copy of the material, to change them alone").clicked() {
+                        let name = unique_name(scene, &format!("{} ({})", material.name, g.facing));
+                        panel.splits.write(GiveOwnMaterial { surfaces: g.surfaces.clone(), name });
+                    }
+                });
             }
             ui.horizontal(|ui| {
                 ui.label("material");
@@ -138,6 +151,11 @@ pub fn material_panel(ui: &mut Ui, edits: &mut MaterialEdits, note: &mut Option<
             }
         }
     });
+}
+
+/// `name`, or with a number after it if a material has that name.
+fn unique_name(scene: &Scene, name: &str) -> String {
+    (1..).map(|k| if k == 1 { name.to_string() } else { format!("{name} {k}") }).find(|n| scene.materials.iter().all(|m| m.name != *n)).expect("a free name")
 }
 
 /// A value is committed when typed, or when a drag ends: relighting on every
