@@ -94,6 +94,7 @@ pub struct SkyRejected {
     pub message: String,
 }
 
+#[allow(clippy::too_many_arguments)]
 fn update_sun_and_sky(
     mut commands: Commands,
     site: Res<Site>,

@@ -74,6 +74,9 @@ pub struct Material {
 /// Reflectance of faces that name no material (with a warning).
 const UNASSIGNED_REFLECTANCE: f32 = 0.5;
 
+/// Materials in order, and each tobj material index's place among them.
+pub type ResolvedMaterials = (Vec<Material>, BTreeMap<Option<usize>, u32>);
+
 /// The materials the model's faces use, in order of tobj's index (faces with
 /// no material last), and each tobj index's place in that list.
 pub fn resolve(
@@ -82,7 +85,7 @@ pub fn resolve(
     panels: &PanelCatalog,
     obj_path: &std::path::Path,
     warnings: &mut Vec<SceneWarning>,
-) -> Result<(Vec<Material>, BTreeMap<Option<usize>, u32>), SceneError> {
+) -> Result<ResolvedMaterials, SceneError> {
     let mut scene_materials = BTreeMap::new();
     for (name, table) in &parsed.materials {
         scene_materials.insert(name.as_str(), scene_material(parsed, name, table, panels)?);

@@ -67,10 +67,8 @@ pub fn scan(path: &Path, text: &str) -> Result<ObjScan, SceneError> {
             "mtllib" if !rest.is_empty() => {
                 scan.material_libraries.push(Reference { line: line_no, name: rest.to_string() })
             }
-            "usemtl" if !rest.is_empty() => {
-                if !scan.used_materials.iter().any(|r| r.name == rest) {
-                    scan.used_materials.push(Reference { line: line_no, name: rest.to_string() });
-                }
+            "usemtl" if !rest.is_empty() && !scan.used_materials.iter().any(|r| r.name == rest) => {
+                scan.used_materials.push(Reference { line: line_no, name: rest.to_string() });
             }
             _ => {}
         }

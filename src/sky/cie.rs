@@ -113,6 +113,6 @@ pub fn compute(
         zenith_radiance: cie.zenith,
         distribution: cie,
         ground_radiance: ground,
-        sun: (solar > 0.0).then(|| SunSource { direction: sun, solid_angle, radiance: solar }),
+        sun: (solar > 0.0).then_some(SunSource { direction: sun, solid_angle, radiance: solar }),
     }
 }

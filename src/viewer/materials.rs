@@ -113,7 +113,7 @@ pub fn material_panel(ui: &mut Ui, edits: &mut MaterialEdits, note: &mut Option<
             let material = &scene.materials[group.material as usize];
             let sharing: Vec<&WindowGroup> = groups.iter().filter(|g| g.material == group.material).collect();
             for g in &sharing {
-                ui.horizontal(|ui| {
+                ui.horizontal_wrapped(|ui| {
                     ui.label(format!("{} windows: {} panes, {:.1} m²", g.facing, g.panes, g.area));
                     // A group sharing its material can take one of its own, to be changed alone.
                     if sharing.len() > 1 && ui.small_button("own material").on_hover_text("give these windows a copy of the material, to change them alone").clicked() {

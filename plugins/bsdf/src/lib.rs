@@ -155,10 +155,10 @@ impl BsdfModel {
         let mut triangulation = DelaunayTriangulation::<Point2<f64>>::new();
         let mut vertex_patch = Vec::new();
         for (i, d) in directions.iter().enumerate() {
-            if let Ok(handle) = triangulation.insert(Point2::new(d.x, d.y)) {
-                if handle.index() == vertex_patch.len() {
-                    vertex_patch.push(i);
-                }
+            if let Ok(handle) = triangulation.insert(Point2::new(d.x, d.y))
+                && handle.index() == vertex_patch.len()
+            {
+                vertex_patch.push(i);
             }
         }
         Self { fitted, triangulation, vertex_patch, captured: if transmitted > 0.0 { captured / transmitted } else { 1.0 } }
