@@ -72,6 +72,9 @@ impl Default for SkySubdivision {
 /// The sun and sky for the current site, time and sky choice.
 #[derive(Resource, Debug, Clone)]
 pub struct SunSky {
+    /// The sun's true position (azimuth from true north). The light and the
+    /// renderer use `sky.sun`, which is in the model's frame: turned by the
+    /// site's `north_turn`.
     pub sun: SolarPosition,
     pub sky: Sky,
     pub patches: Arc<SkyPatches>,

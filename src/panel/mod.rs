@@ -141,6 +141,29 @@ impl Key {
     }
 }
 
+/// Checks a panel's key declarations: names unique, ranges finite and in
+/// order, defaults inside them, lists not empty, files required. A panel
+/// whose keys fail this cannot be built ([`PanelCatalog::build`] says why);
+/// panel crates check it in their tests.
+pub fn check_keys(keys: &[Key]) -> Result<(), String> {
+    for (i, key) in keys.iter().enumerate() {
+        let bad = |why: &str| Err(format!("key '{}': {why}", key.name));
+        if keys[..i].iter().any(|k| k.name == key.name) {
+            return bad("declared twice");
+        }
+        let numbers = |(lo, hi): (f64, f64), defaults: &[f64]| lo.is_finite() && hi.is_finite() && lo <= hi && defaults.iter().all(|d| (lo..=hi).contains(d));
+        match key.kind {
+            KeyKind::Number { range, default } if !numbers(range, &[default]) => return bad("its range must be finite and in order, its default inside it"),
+            KeyKind::Numbers { default: [], .. } => return bad("a list needs a default as long as the list"),
+            KeyKind::Numbers { range, default } if !numbers(range, default) => return bad("its range must be finite and in order, its defaults inside it"),
+            KeyKind::Count { range: (lo, hi), default } if lo > hi || !(lo..=hi).contains(&default) => return bad("its range must be in order, its default inside it"),
+            KeyKind::File { .. } if !key.required => return bad("a file key must be required"),
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 /// Every key at its default (files left out): where the UI starts when a
 /// window is switched to a panel.
 pub fn default_values(keys: &[Key]) -> toml::Table {
@@ -219,9 +242,8 @@ impl Parameters {
     /// A [`KeyKind::Numbers`] key of `N` numbers.
     pub fn numbers<const N: usize>(&self, key: &Key) -> Result<[f64; N], ParameterError> {
         let KeyKind::Numbers { range, default } = key.kind else { return Err(Self::undeclared(key, "a list of numbers")) };
-        let Some(value) = self.given(key)? else {
-            return default.try_into().map_err(|_| Self::undeclared(key, &format!("a list of {N} numbers")));
-        };
+        let Ok(default) = <[f64; N]>::try_from(default) else { return Err(Self::undeclared(key, &format!("a list of {N} numbers"))) };
+        let Some(value) = self.given(key)? else { return Ok(default) };
         let toml::Value::Array(items) = value else { return Err(ParameterError::new(key.name, format!("must be a list of {N} numbers"))) };
         if items.len() != N {
             return Err(ParameterError::new(key.name, format!("must be a list of {N} numbers, not {}", items.len())));
@@ -297,6 +319,7 @@ impl PanelCatalog {
     /// unknown keys refused.
     pub fn build(&self, name: &str, parameters: &Parameters) -> Result<Arc<dyn PanelModel>, ParameterError> {
         let panel = self.get(name).ok_or_else(|| ParameterError::new("panel", format!("no panel named '{name}' is registered")))?;
+        check_keys(panel.keys()).map_err(|e| ParameterError::new("panel", format!("panel '{name}' declares its keys wrongly: {e}")))?;
         if let Some(key) = parameters.unknown_key(panel.keys()) {
             return Err(ParameterError::new(key, format!("is not a key of panel '{name}' (its keys: {})", panel.keys().iter().map(|k| k.name).collect::<Vec<_>>().join(", "))));
         }
@@ -396,5 +419,12 @@ mod tests {
         assert!(p.count(&A).unwrap_err().message.contains("not declared"));
         assert_eq!(p.unknown_key(&[A, B, C]), Some("n"));
         assert_eq!(B.default_value(), Some(toml::Value::Array(vec![1.0.into(), 1.0.into()])));
+        // Declarations a panel could get wrong.
+        assert_eq!(check_keys(&[A, B, C, N]), Ok(()));
+        assert!(check_keys(&[A, A_HIGH]).unwrap_err().contains("twice"));
+        assert!(check_keys(&[Key::number("x", "", (0.0, 1.0), 2.0)]).unwrap_err().contains("default"));
+        assert!(check_keys(&[Key::number("x", "", (0.0, f64::INFINITY), 2.0)]).is_err());
+        assert!(check_keys(&[Key::numbers("x", "", (0.0, 1.0), &[])]).is_err());
+        assert!(check_keys(&[Key { required: false, ..C }]).is_err());
     }
 }

@@ -95,6 +95,8 @@ pub fn navigate(
     *last_cursor = window.cursor_position();
     let over_panels = ui.as_ref().zip(window.cursor_position()).is_some_and(|(ui, cursor)| ui.over_panels(cursor));
     let walking = ui.as_ref().is_some_and(|ui| ui.walk);
+    // Keys typed into a panel field are for the field.
+    let keys_for_camera = !ui.as_ref().is_some_and(|ui| ui.keyboard_for_panels);
     let buttons = [MouseButton::Left, MouseButton::Right, MouseButton::Middle];
     for (mut cad, mut transform, camera, global, projection) in &mut cameras {
         let fov = match projection {
@@ -137,7 +139,7 @@ pub fn navigate(
             let right = forward.cross(Vec3::Z);
             let mut step = Vec3::ZERO;
             for (key, direction) in [(KeyCode::KeyW, forward), (KeyCode::KeyS, -forward), (KeyCode::KeyD, right), (KeyCode::KeyA, -right)] {
-                if keys.pressed(key) {
+                if keys_for_camera && keys.pressed(key) {
                     step += direction;
                 }
             }
@@ -168,7 +170,8 @@ pub fn navigate(
             cad.focus = anchor + (cad.focus - anchor) * factor;
             cad.distance *= factor;
         }
-        if keys.just_pressed(KeyCode::KeyF)
+        if keys_for_camera
+            && keys.just_pressed(KeyCode::KeyF)
             && let Some(scene) = &active.scene
         {
             let (centre, distance) = framing(scene.bounds, fov.to_degrees());

@@ -15,8 +15,15 @@ pub struct ShownLobes(pub Option<usize>);
 /// Length (m) of an arrow carrying all of the incoming light.
 const ARROW_LENGTH: f32 = 1.5;
 
-pub fn select_panel_window(keys: Res<ButtonInput<KeyCode>>, active: Res<ActiveScene>, ray_model: Option<Res<RayModel>>, mut shown: ResMut<ShownLobes>) {
-    if !keys.just_pressed(KeyCode::KeyL) {
+pub fn select_panel_window(
+    keys: Res<ButtonInput<KeyCode>>,
+    ui: Option<Res<super::ui::UiState>>,
+    active: Res<ActiveScene>,
+    ray_model: Option<Res<RayModel>>,
+    mut shown: ResMut<ShownLobes>,
+) {
+    // An L typed into a panel field is for the field.
+    if !keys.just_pressed(KeyCode::KeyL) || ui.is_some_and(|ui| ui.keyboard_for_panels) {
         return;
     }
     let (Some(scene), Some(model)) = (&active.scene, ray_model) else { return };

@@ -222,17 +222,27 @@ fn window_material(
             }
             let mut values = edits.pending[&index].values.clone();
             let mut changed = false;
+            let note_before = note.clone();
             for key in keys {
                 let files = match key.kind {
                     KeyKind::File { extension } => edits.offered_files(base, extension).to_vec(),
                     _ => Vec::new(),
                 };
-                changed |= key_widget(ui, key, &mut values, &files, note);
+                changed |= key_widget(ui, index, key, &mut values, &files, note);
             }
             if let Some(pending) = edits.pending.get_mut(&index) {
                 pending.values = values.clone();
             }
-            if changed { build(note, catalog, panel, values, *up, base) } else { None }
+            if !changed {
+                return None;
+            }
+            let built = build(note, catalog, panel, values, *up, base);
+            if built.is_some() && *note == note_before {
+                // An earlier note (say, why an edit was refused) is out of date;
+                // one this edit made (a clamped value) stays.
+                *note = None;
+            }
+            built
         }
         MaterialKind::Diffuse { .. } => None,
     }
@@ -244,7 +254,6 @@ fn build(note: &mut Option<String>, catalog: &PanelCatalog, panel: &str, values:
     let parameters = Parameters::new(values, base);
     match catalog.build(panel, &parameters) {
         Ok(model) => {
-            // A note from this edit (a clamped value) stays on show.
             Some(MaterialKind::Panel { panel: panel.to_string(), up, parameters: parameters.values, model: crate::panel::PanelHandle(model) })
         }
         Err(e) => {
@@ -254,9 +263,9 @@ fn build(note: &mut Option<String>, catalog: &PanelCatalog, panel: &str, values:
     }
 }
 
-/// The widget of one panel key, editing `values`; true when a change is
-/// committed. Values typed outside the key's range are clamped, with a note.
-fn key_widget(ui: &mut Ui, key: &Key, values: &mut toml::Table, files: &[String], note: &mut Option<String>) -> bool {
+/// The widget of one panel key of window material `material`, editing
+/// `values`; true when a change is committed. Values typed outside the key's range are clamped, with a note.
+fn key_widget(ui: &mut Ui, material: u32, key: &Key, values: &mut toml::Table, files: &[String], note: &mut Option<String>) -> bool {
     let number = |v: &toml::Value| v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
     let given = values.get(key.name).cloned();
     let label = format!("{} ", key.name);
@@ -275,8 +284,10 @@ fn key_widget(ui: &mut Ui, key: &Key, values: &mut toml::Table, files: &[String]
                 };
                 ui.label(&label).on_hover_text(key.help);
                 let mut commit = false;
-                for v in &mut list {
-                    commit |= committed(&bounded(ui, v, range.0..=range.1, (range.1 - range.0) / 500.0, "", "", note));
+                for (i, v) in list.iter_mut().enumerate() {
+                    let response = ui.add(egui::DragValue::new(v).speed((range.1 - range.0) / 500.0));
+                    clamp_noted(v, range.0..=range.1, &format!("{}[{i}] ", key.name), "", note);
+                    commit |= committed(&response);
                 }
                 values.insert(key.name.into(), toml::Value::Array(list.into_iter().map(toml::Value::Float).collect()));
                 commit
@@ -291,7 +302,7 @@ fn key_widget(ui: &mut Ui, key: &Key, values: &mut toml::Table, files: &[String]
                 let mut file = given.as_ref().and_then(toml::Value::as_str).unwrap_or_default().to_string();
                 ui.label(&label).on_hover_text(key.help);
                 let mut commit = false;
-                egui::ComboBox::from_id_salt(("key_file", key.name)).selected_text(&file).show_ui(ui, |ui| {
+                egui::ComboBox::from_id_salt(("key_file", material, key.name)).selected_text(&file).show_ui(ui, |ui| {
                     for offered in files {
                         commit |= ui.selectable_value(&mut file, offered.clone(), offered).clicked();
                     }
@@ -319,7 +330,8 @@ impl MaterialEdits {
                 folder = parent.to_path_buf();
                 relative.push("..");
             }
-            found.sort();
+            // The scene's own folder first, then further up.
+            found.sort_by_key(|name| (name.matches("../").count(), name.clone()));
             found
         })
     }
@@ -390,7 +402,7 @@ mod tests {
         let mut values: toml::Table = toml::from_str("a = 5.0\nb = 0.0").unwrap();
         let ctx = egui::Context::default();
         let mut output = ctx.run_ui(egui::RawInput::default(), |ui| {
-            key_widget(ui, &A, &mut values, &[], &mut note);
+            key_widget(ui, 0, &A, &mut values, &[], &mut note);
         });
         output.textures_delta.clear();
         assert_eq!(values["a"].as_float(), Some(1.0));

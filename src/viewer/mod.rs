@@ -1,8 +1,10 @@
 //! The interactive viewer: a window on a scene with the CAD camera
-//! ([`camera`]), the designer's panels ([`ui`]) and panel lobes
+//! ([`camera`]), the designer's panels ([`ui`], [`materials`]), sensors
+//! ([`sensors`]), saving the view ([`capture`]) and panel lobes
 //! ([`lobes`]), drawn by [`crate::render::HeliodonRenderPlugin`]. With a
-//! screenshot request it waits for the light to converge, saves the window
-//! and exits (`heliodon view SCENE --screenshot FILE`).
+//! save request (`heliodon view SCENE --screenshot FILE --hdr FILE`, and
+//! `--sensor NAME [--year]` to select a sensor and wait for its plots) it
+//! waits for the light to converge, saves and exits.
 
 pub mod camera;
 pub mod capture;

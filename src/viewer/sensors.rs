@@ -57,7 +57,8 @@ impl<K: PartialEq, T: Send + 'static> Background<K, T> {
 }
 
 /// The selected sensor's total illuminance (lux) over the day, by half
-/// hour from 00:15; keyed by sensor, date, sky and site (a new key restarts it).
+/// hour from 00:15; keyed by sensor, date, sky, site and light model (a new
+/// key restarts it).
 #[derive(Resource, Default)]
 pub struct DaySeries(pub Background<(usize, Date, String), Vec<f64>>);
 
@@ -68,7 +69,7 @@ pub const YEAR_DAYS: usize = 26;
 /// thesis' figure 1.4h), computed in the background when asked for.
 #[derive(Resource, Default)]
 pub struct YearMap {
-    /// Keyed by sensor, year, sky and site.
+    /// Keyed by sensor, year, sky, site and light model.
     pub map: Background<(usize, i32, String), Vec<Vec<f64>>>,
     /// Days done, for the progress bar.
     done: Arc<AtomicUsize>,
@@ -94,9 +95,12 @@ pub fn update_year_map(
     mut year: ResMut<YearMap>,
 ) {
     year.map.collect();
-    let key = selected.0.map(|s| (s, solar.0.date.year, format!("{:?} {:?}", sky.0, site.as_ref().map(|s| s.0))));
+    // The light model is part of the key: edited materials make a new one.
+    let model = engine.as_ref().and_then(|e| e.model.as_ref()).map(Arc::as_ptr);
+    let key = selected.0.map(|s| (s, solar.0.date.year, format!("{:?} {:?} {model:?}", sky.0, site.as_ref().map(|s| s.0))));
     if year.map.key.is_some() && year.map.key != key && year.map.task.is_none() {
-        // What is shown no longer fits the sensor or sky.
+        // What is shown no longer fits the sensor, sky, site or light model:
+        // it goes, and a new year waits for a new request.
         year.map = Background::default();
     }
     // A request waits for the sensor and the light engine's model.
@@ -203,7 +207,8 @@ pub fn update_day_series(
 ) {
     series.0.collect();
     let (Some(sensor), Some(site), Some(model)) = (selected.0, site, engine.and_then(|e| e.model.clone())) else { return };
-    let key = (sensor, solar.0.date, format!("{:?} {:?}", sky.0, site.0));
+    // The light model is part of the key: edited materials make a new one.
+    let key = (sensor, solar.0.date, format!("{:?} {:?} {:?}", sky.0, site.0, Arc::as_ptr(&model)));
     if series.0.key.as_ref() == Some(&key) {
         return;
     }

@@ -72,6 +72,8 @@ pub struct UiState {
     /// egui saw it at `pointer_checked_at`; see [`UiState::over_panels`].
     pub pointer_over_panels: bool,
     pub pointer_checked_at: Option<Vec2>,
+    /// A panel field has the keyboard (keys typed are not for the camera).
+    pub keyboard_for_panels: bool,
     /// Last clamped input or saved file, shown until the next one.
     pub note: Option<String>,
     /// Views the user saved this session.
@@ -223,6 +225,7 @@ fn panels(
         .width();
     ui_state.pointer_over_panels = ctx.is_pointer_over_egui();
     ui_state.pointer_checked_at = window.cursor_position();
+    ui_state.keyboard_for_panels = ctx.egui_wants_keyboard_input();
     // The 3D view: what the panels leave.
     let scale = window.scale_factor();
     let (left, right) = ((left * scale) as u32, (right * scale) as u32);
@@ -285,16 +288,11 @@ fn sun_and_sky_panel(
         }
     });
     let mut minutes = (time.hours() * 60.0).round() as i64;
-    let clock = |m: f64, _: std::ops::RangeInclusive<usize>| format!("{:02}:{:02}", m as i64 / 60, m as i64 % 60);
+    let clock = |m: f64, _: std::ops::RangeInclusive<usize>| clock_text(m as i64);
     ui.add(egui::Slider::new(&mut minutes, 0..=1439).text("time").custom_formatter(clock).clamping(egui::SliderClamping::Never));
     ui.horizontal(|ui| {
         ui.label("exact");
-        ui.add(
-            egui::DragValue::new(&mut minutes).custom_formatter(clock).custom_parser(|text| {
-                let (h, m) = text.split_once(':')?;
-                Some(h.trim().parse::<f64>().ok()? * 60.0 + m.trim().parse::<f64>().ok()?)
-            }),
-        );
+        ui.add(egui::DragValue::new(&mut minutes).custom_formatter(clock).custom_parser(|text| parse_clock(text).map(|m| m as f64)));
         let label = if state.playing.is_some() { "Pause" } else { "Play the day" };
         if ui.button(label).clicked() {
             state.playing = if state.playing.is_some() { None } else { Some(0.5) };
@@ -302,7 +300,7 @@ fn sun_and_sky_panel(
     });
     if !(0..=1439).contains(&minutes) {
         let clamped = minutes.clamp(0, 1439);
-        state.note = Some(format!("time {}:{:02} is outside 00:00..23:59: {:02}:{:02} is used", minutes.div_euclid(60), minutes.rem_euclid(60), clamped / 60, clamped % 60));
+        state.note = Some(format!("time {} is outside 00:00..23:59: {} is used", clock_text(minutes), clock_text(clamped)));
         minutes = clamped;
     }
     let time = TimeOfDay::from_hours(minutes as f64 / 60.0).unwrap_or(time);
@@ -353,6 +351,22 @@ fn sun_and_sky_panel(
     if let Some(note) = &state.note {
         ui.colored_label(egui::Color32::from_rgb(230, 160, 60), note);
     }
+}
+
+/// Minutes as HH:MM (a sign in front when negative).
+fn clock_text(minutes: i64) -> String {
+    let sign = if minutes < 0 { "-" } else { "" };
+    format!("{sign}{:02}:{:02}", minutes.abs() / 60, minutes.abs() % 60)
+}
+
+/// Minutes from HH:MM typed by hand; minutes past 59 or anything that is
+/// not a clock time is refused (the field keeps its value).
+fn parse_clock(text: &str) -> Option<i64> {
+    let (h, m) = text.trim().split_once(':')?;
+    let (h, m) = (h.trim(), m.trim().parse::<i64>().ok().filter(|m| (0..60).contains(m))?);
+    let hours = h.trim_start_matches('-').parse::<i64>().ok()?;
+    let minutes = hours * 60 + m;
+    Some(if h.starts_with('-') { -minutes } else { minutes })
 }
 
 /// A number field: what is typed outside `range` is clamped into it, with a
@@ -498,7 +512,10 @@ fn view_panel(ui: &mut Ui, state: &mut UiState, settings: &mut ResMut<RenderSett
         if ui.button("Save image (PNG)").clicked() {
             state.save_image = Some(ImageFormat::Png);
         }
-        if ui.button("Save luminance (HDR)").on_hover_text("the 3D view in cd/m², as a Radiance picture").clicked() {
+        // False colour is a legend's colours, not light: no luminance to save.
+        let luminance = settings.mode != RenderMode::FalseColour;
+        let hdr = ui.add_enabled(luminance, egui::Button::new("Save luminance (HDR)"));
+        if hdr.on_hover_text("the 3D view in cd/m² (of the light the mode shows), as a Radiance picture").on_disabled_hover_text("false colour has no luminance to save").clicked() {
             state.save_image = Some(ImageFormat::Hdr);
         }
     });
@@ -664,11 +681,15 @@ pub fn apply_camera_request(mut state: ResMut<UiState>, active: Res<ActiveScene>
     }
 }
 
-/// Saves the view when asked, into the working folder, named by the time.
+/// Saves the view when asked, into the working folder, named by the time
+/// (and a number, when that name is taken: nothing is overwritten).
 fn save_image(mut state: ResMut<UiState>, mut saves: MessageWriter<SaveView>) {
     let Some(format) = state.save_image.take() else { return };
     let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
-    let name = PathBuf::from(format!("heliodon-view-{stamp}.{}", format.extension()));
+    let name = (1..)
+        .map(|k| PathBuf::from(if k == 1 { format!("heliodon-view-{stamp}.{}", format.extension()) } else { format!("heliodon-view-{stamp}-{k}.{}", format.extension()) }))
+        .find(|path| !path.exists())
+        .expect("a free name");
     state.note = Some(format!("saving {}", name.display()));
     saves.write(match format {
         ImageFormat::Png => SaveView::Png(name),
@@ -733,5 +754,11 @@ mod tests {
         assert_eq!((month, ev), (12, 20.0));
         assert_eq!(month_note.as_deref(), Some("month 13 is outside 1..12: 12 is used"));
         assert_eq!(ev_note.as_deref(), Some("EV 30 is outside -5..20: 20 is used"));
+        // Clock times typed by hand.
+        assert_eq!(parse_clock("09:30"), Some(570));
+        assert_eq!(parse_clock("25:30"), Some(1530));
+        assert_eq!(parse_clock("-0:30"), Some(-30));
+        assert_eq!((parse_clock("10:75"), parse_clock("noon")), (None, None));
+        assert_eq!(clock_text(-30), "-00:30");
     }
 }

@@ -59,8 +59,8 @@ impl PanelType for Bsdf {
         let path = parameters.path(&FILE)?;
         let lobes = parameters.count(&LOBES)? as usize;
         let width = parameters.number(&LOBE_WIDTH)?;
-        let text = std::fs::read_to_string(&path).map_err(|e| ParameterError::new("file", format!("cannot read {}: {e}", path.display())))?;
-        let file = xml::parse(&text, &path).map_err(|e| ParameterError::new("file", e))?;
+        let text = std::fs::read_to_string(&path).map_err(|e| ParameterError::new(FILE.name, format!("cannot read {}: {e}", path.display())))?;
+        let file = xml::parse(&text, &path).map_err(|e| ParameterError::new(FILE.name, e))?;
         Ok(Arc::new(BsdfModel::fit(&file, lobes, width)))
     }
 }
@@ -340,6 +340,7 @@ mod tests {
 
     #[test]
     fn keys_are_checked() {
+        assert_eq!(heliodon::panel::check_keys(Bsdf.keys()), Ok(()));
         let folder = sample("clear.xml").parent().unwrap().to_path_buf();
         let build = |text: &str| Bsdf.build(&Parameters::from_toml(text, folder.clone()).unwrap());
         assert!(build("file = \"clear.xml\"").is_ok());

@@ -183,6 +183,7 @@ mod tests {
 
     #[test]
     fn keys_are_checked() {
+        assert_eq!(heliodon::panel::check_keys(LaserCut.keys()), Ok(()));
         let build = |text: &str| LaserCut.build(&Parameters::from_toml(text, "").unwrap());
         assert!(build("cut_spacing_ratio = 0.5").is_ok());
         assert!(LaserCut.build(&Parameters::new(heliodon::panel::default_values(LaserCut.keys()), "")).is_ok());

@@ -45,7 +45,7 @@ impl PanelType for Prismatic {
     fn build(&self, parameters: &Parameters) -> Result<Arc<dyn PanelModel>, ParameterError> {
         let [a, b] = parameters.numbers(&FACET_ANGLES)?;
         if a + b <= 0.0 {
-            return Err(ParameterError::new("facet_angles", "at least one facet must be tilted"));
+            return Err(ParameterError::new(FACET_ANGLES.name, "at least one facet must be tilted"));
         }
         let index = parameters.number(&REFRACTIVE_INDEX)?;
         Ok(Arc::new(PrismaticModel::new([a, b], index)))
@@ -237,6 +237,7 @@ mod tests {
 
     #[test]
     fn keys_are_checked() {
+        assert_eq!(heliodon::panel::check_keys(Prismatic.keys()), Ok(()));
         let build = |text: &str| Prismatic.build(&Parameters::from_toml(text, "").unwrap());
         assert!(build("facet_angles = [40.0, 5.0]").is_ok());
         assert!(Prismatic.build(&Parameters::new(heliodon::panel::default_values(Prismatic.keys()), "")).is_ok());

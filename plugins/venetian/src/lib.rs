@@ -47,7 +47,7 @@ impl PanelType for Venetian {
         let specular = parameters.number(&SPECULAR)?;
         let diffuse = parameters.number(&DIFFUSE)?;
         if specular + diffuse > 1.0 {
-            return Err(ParameterError::new("diffuse", format!("specular + diffuse = {} is more than 1", specular + diffuse)));
+            return Err(ParameterError::new(DIFFUSE.name, format!("specular + diffuse = {} is more than 1", specular + diffuse)));
         }
         Ok(Arc::new(VenetianModel { width, spacing, tilt: tilt.to_radians(), specular, diffuse }))
     }
@@ -224,6 +224,7 @@ mod tests {
 
     #[test]
     fn keys_are_checked() {
+        assert_eq!(heliodon::panel::check_keys(Venetian.keys()), Ok(()));
         let build = |text: &str| Venetian.build(&Parameters::from_toml(text, "").unwrap());
         let ok = "slat_width = 0.025\nslat_spacing = 0.0225\ntilt = 30.0\nspecular = 0.9\ndiffuse = 0.05";
         assert!(build(ok).is_ok());
