@@ -7,6 +7,7 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task, block_on, futures_lite::future};
 
@@ -84,20 +85,36 @@ impl YearMap {
     }
 }
 
+/// What the day and year plots are computed from.
+#[derive(SystemParam)]
+pub struct PlotInputs<'w> {
+    selected: Res<'w, SelectedSensor>,
+    solar: Res<'w, SolarTime>,
+    sky: Res<'w, SkyChoice>,
+    site: Option<Res<'w, Site>>,
+    engine: Option<Res<'w, LightEngine>>,
+}
+
+impl PlotInputs<'_> {
+    /// The selected sensor, the site and the light model, once all are there.
+    fn ready(&self) -> Option<(usize, crate::site::Site, Arc<LightModel>)> {
+        Some((self.selected.0?, self.site.as_ref()?.0, self.engine.as_ref()?.model.clone()?))
+    }
+
+    /// What a sensor's light depends on besides the date: the sky, the site
+    /// and the light model (edited materials make a new one).
+    fn light_key(&self) -> String {
+        let model = self.engine.as_ref().and_then(|e| e.model.as_ref()).map(Arc::as_ptr);
+        format!("{:?} {:?} {model:?}", self.sky.0, self.site.as_ref().map(|s| s.0))
+    }
+}
+
 /// Starts the year map when asked (for the selected sensor, the current
 /// year and sky), and collects it.
-pub fn update_year_map(
-    selected: Res<SelectedSensor>,
-    solar: Res<SolarTime>,
-    sky: Res<SkyChoice>,
-    site: Option<Res<Site>>,
-    engine: Option<Res<LightEngine>>,
-    mut year: ResMut<YearMap>,
-) {
+pub fn update_year_map(inputs: PlotInputs, mut year: ResMut<YearMap>) {
     year.map.collect();
-    // The light model is part of the key: edited materials make a new one.
-    let model = engine.as_ref().and_then(|e| e.model.as_ref()).map(Arc::as_ptr);
-    let key = selected.0.map(|s| (s, solar.0.date.year, format!("{:?} {:?} {model:?}", sky.0, site.as_ref().map(|s| s.0))));
+    let first = inputs.solar.0.date.year;
+    let key = inputs.selected.0.map(|s| (s, first, inputs.light_key()));
     if year.map.key.is_some() && year.map.key != key && year.map.task.is_none() {
         // What is shown no longer fits the sensor, sky, site or light model:
         // it goes, and a new year waits for a new request.
@@ -107,9 +124,9 @@ pub fn update_year_map(
     if !year.requested {
         return;
     }
-    let (Some(sensor), Some(site), Some(model)) = (selected.0, site, engine.and_then(|e| e.model.clone())) else { return };
+    let Some((sensor, site, model)) = inputs.ready() else { return };
     year.requested = false;
-    let (first, spec, site) = (solar.0.date.year, sky.0.clone(), site.0);
+    let spec = inputs.sky.0.clone();
     let done = Arc::new(AtomicUsize::new(0));
     year.done = done.clone();
     year.map.start(key, move || {
@@ -195,24 +212,17 @@ pub fn pick_sensor(
     }
 }
 
-/// Starts the selected sensor's day series when the sensor, date, sky or
-/// site change, and collects it when done.
-pub fn update_day_series(
-    selected: Res<SelectedSensor>,
-    solar: Res<SolarTime>,
-    sky: Res<SkyChoice>,
-    site: Option<Res<Site>>,
-    engine: Option<Res<LightEngine>>,
-    mut series: ResMut<DaySeries>,
-) {
+/// Starts the selected sensor's day series when the sensor, date, sky,
+/// site or light model change, and collects it when done.
+pub fn update_day_series(inputs: PlotInputs, mut series: ResMut<DaySeries>) {
     series.0.collect();
-    let (Some(sensor), Some(site), Some(model)) = (selected.0, site, engine.and_then(|e| e.model.clone())) else { return };
-    // The light model is part of the key: edited materials make a new one.
-    let key = (sensor, solar.0.date, format!("{:?} {:?} {:?}", sky.0, site.0, Arc::as_ptr(&model)));
+    let Some((sensor, site, model)) = inputs.ready() else { return };
+    let date = inputs.solar.0.date;
+    let key = (sensor, date, inputs.light_key());
     if series.0.key.as_ref() == Some(&key) {
         return;
     }
-    let (date, spec, site) = (solar.0.date, sky.0.clone(), site.0);
+    let spec = inputs.sky.0.clone();
     series.0.start(Some(key), move || day_series(&model, sensor, &site, date, &spec));
 }
 
