@@ -1,57 +1,35 @@
 //! heliodon: a digital heliodon for daylighting design.
 //!
 //! Layers, from the bottom (see ARCHITECTURE.md):
-//! - science, plain Rust without Bevy types: [`site`], [`time`], [`scene`],
-//!   [`sun`], [`sky`], [`light`], [`panel`] (the panel API);
+//! - the science, plain Rust without Bevy: the `heliodon-core` crate,
+//!   re-exported here ([`site`], [`time`], [`scene`], [`sun`], [`sky`],
+//!   [`light`], [`day`], [`panel`] (the panel API), [`sun_pass`] (what the
+//!   stencil pass draws), [`radiance`]);
 //! - the ECS layer: [`ecs`] ([`HeliodonPlugins`], runs headless);
 //! - drawing: [`render`]; the window and its input: [`viewer`];
-//! - the command line: [`cli`]; Radiance export: [`radiance`].
+//! - the command line: [`cli`].
 
 pub mod cli;
 pub mod ecs;
-pub mod light;
-pub mod panel;
-pub mod radiance;
 pub mod render;
-pub mod scene;
-pub mod site;
-pub mod sky;
-pub mod sun;
-pub mod time;
 pub mod viewer;
 
-use std::path::{Path, PathBuf};
+pub use heliodon_core::{BUNDLED_SCENES, bundled_scene, day, light, panel, radiance, scene, site, sky, sun, sun_pass, time};
 
 use bevy::asset::{AssetMetaCheck, AssetPlugin, UnapprovedPathMode};
 
-pub use ecs::HeliodonPlugins;
-/// The Bevy and glam heliodon is built on, for panel plugins (one version for all).
+/// The Bevy and glam heliodon is built on (one version for all).
 pub use bevy;
+pub use ecs::HeliodonPlugins;
 pub use glam;
+/// The core crate itself, for what its modules do not name.
+pub use heliodon_core;
 
 /// The `AssetPlugin` heliodon apps need: scene files are opened by absolute
 /// path wherever they are, and carry no `.meta` files.
 pub fn asset_plugin() -> AssetPlugin {
-    AssetPlugin {
-        unapproved_path_mode: UnapprovedPathMode::Allow,
-        meta_check: AssetMetaCheck::Never,
-        ..Default::default()
-    }
+    AssetPlugin { unapproved_path_mode: UnapprovedPathMode::Allow, meta_check: AssetMetaCheck::Never, ..Default::default() }
 }
-
-/// The bundled scenes, by folder name under `assets/scenes/`.
-pub const BUNDLED_SCENES: [&str; 3] = ["test_room", "office", "living_room"];
 
 /// The scene the viewer opens when given none.
 pub const DEFAULT_SCENE: &str = "office";
-
-/// Path of a bundled scene: under `./assets` when run from a checkout's root,
-/// else under the crate's own folder.
-pub fn bundled_scene(name: &str) -> PathBuf {
-    let relative = Path::new("assets/scenes").join(name).join("scene.toml");
-    if relative.exists() {
-        relative
-    } else {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
-    }
-}

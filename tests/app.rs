@@ -6,16 +6,15 @@ use std::time::{Duration, Instant};
 
 use bevy::prelude::*;
 use heliodon::ecs::{
-    ActiveScene, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, SceneSensor, SceneSpawned, SceneSurface,
-    SceneWindow, Site,
+    ActiveScene, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, SceneSensor, SceneSpawned, SceneSurface, SceneWindow, Site,
 };
 use std::sync::Arc;
 
 use heliodon::light::LightModel;
+use heliodon::panel::PanelCatalog;
 use heliodon::render::offscreen::{self, OffscreenRequest};
 use heliodon::render::reference::{self, SunComparison};
 use heliodon::render::{RenderMode, RenderSettings, initial_view};
-use heliodon::panel::PanelCatalog;
 use heliodon::scene::{Scene, Viewpoint, load_scene};
 use heliodon::sky::{Sky, SkySpec};
 use heliodon::sun::solar_position;
@@ -61,15 +60,7 @@ fn every_bundled_scene_spawns_its_entities() {
     let expected = [
         Expected { name: "test_room", diffuse: 3, glass: 1, windows: 6, window_area: 4.59, sensors: 65, latitude: 42.36 },
         Expected { name: "office", diffuse: 7, glass: 3, windows: 12, window_area: 24.88, sensors: 150, latitude: 42.36 },
-        Expected {
-            name: "living_room",
-            diffuse: 5,
-            glass: 2,
-            windows: 16,
-            window_area: 15.300,
-            sensors: 28,
-            latitude: 37.77,
-        },
+        Expected { name: "living_room", diffuse: 5, glass: 2, windows: 16, window_area: 15.300, sensors: 28, latitude: 37.77 },
     ];
     // One app opens the scenes in turn: each replaces the previous one.
     let mut app = headless_app();
@@ -121,7 +112,16 @@ fn a_failed_load_reports_one_line_and_keeps_the_previous_scene() {
 
 #[test]
 fn render_smoke_test_draws_the_model() {
-    let request = OffscreenRequest { scene: heliodon::bundled_scene("test_room"), view: None, width: 320, height: 240, when: None, sky: None, settings: Default::default(), add_panels: |_| {} };
+    let request = OffscreenRequest {
+        scene: heliodon::bundled_scene("test_room"),
+        view: None,
+        width: 320,
+        height: 240,
+        when: None,
+        sky: None,
+        settings: Default::default(),
+        panels: Default::default(),
+    };
     let image = offscreen::render(request).expect("render");
     let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("render_smoke_test_room.png");
     image.save_png(&out).unwrap();
@@ -201,11 +201,12 @@ fn the_sun_and_sky_follow_the_clock_once_per_change() {
 /// A headless app with a quick light engine and no cache, with the bundled
 /// scene `name` open.
 fn lit_app(name: &str) -> App {
-    use heliodon::ecs::{LightCacheDir, LightingSettings};
+    use heliodon::ecs::{self, LightCacheDir};
     use heliodon::light::LightSettings;
     let mut app = headless_app();
-    let settings = LightSettings { rays_per_patch: 64, rays_per_sensor: 512, sun_samples_per_patch: 4, area_sensor_sun_grid: 4, ..Default::default() };
-    app.insert_resource(LightingSettings(settings)).insert_resource(LightCacheDir(None));
+    let settings =
+        LightSettings { rays_per_patch: 64, rays_per_sensor: 512, sun_samples_per_patch: 4, area_sensor_sun_grid: 4, ..Default::default() };
+    app.insert_resource(ecs::LightSettings(settings)).insert_resource(LightCacheDir(None));
     open(&mut app, heliodon::bundled_scene(name)).unwrap();
     app
 }
@@ -274,10 +275,14 @@ fn compare_direct_sun(path: &std::path::Path, view: &Viewpoint, date: &str, time
         when: Some(LocalDateTime { date: Date::parse(date).unwrap(), time: TimeOfDay::parse(time).unwrap() }),
         sky: Some(SkySpec::Clear { turbidity: 2.45 }),
         settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
-        add_panels: |_| {},
+        panels: Default::default(),
     };
     let scene_name = path.parent().and_then(|p| p.file_name()).unwrap().to_string_lossy();
-    let file = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("sun_{scene_name}_{}_{}.png", view.name.replace(' ', "_"), time.replace(':', "")));
+    let file = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "sun_{scene_name}_{}_{}.png",
+        view.name.replace(' ', "_"),
+        time.replace(':', "")
+    ));
     let result = reference::compare_direct_sun(&request, &file).expect("render and compare");
     let summary = format!("{scene_name} {} {date} {time}: {result} -> {}", view.name, file.display());
     println!("{summary}");
@@ -292,7 +297,11 @@ fn direct_sun_images_agree_with_a_ray_traced_reference() {
         let path = heliodon::bundled_scene(name);
         let scene = load_scene(&path, &PanelCatalog::new()).unwrap().scene;
         let overview = initial_view(&Scene { viewpoints: Vec::new(), ..scene.clone() });
-        let cases = [(&scene.viewpoints[0], "2026-03-21", "10:00"), (&scene.viewpoints[0], "2026-11-10", "14:30"), (&overview, "2026-12-21", "12:00")];
+        let cases = [
+            (&scene.viewpoints[0], "2026-03-21", "10:00"),
+            (&scene.viewpoints[0], "2026-11-10", "14:30"),
+            (&overview, "2026-12-21", "12:00"),
+        ];
         for (view, date, time) in cases {
             let (result, summary) = compare_direct_sun(&path, view, date, time);
             assert!(result.compared > 320 * 200 / 10, "{summary}");
@@ -314,7 +323,11 @@ fn cameras_inside_a_sunbeam_and_inside_a_shadow_see_the_sun_right() {
     let sky = Sky::new(&SkySpec::Clear { turbidity: 2.45 }, position.altitude, position.azimuth, 0.2, 80).unwrap();
     let sun = sky.sun.unwrap();
     // Half a metre in from the middle of the lower middle pane, along the beam.
-    let pane = scene.windows.iter().min_by(|a, b| (a.centroid.x - 2.0).abs().total_cmp(&(b.centroid.x - 2.0).abs()).then(a.centroid.z.total_cmp(&b.centroid.z))).unwrap();
+    let pane = scene
+        .windows
+        .iter()
+        .min_by(|a, b| (a.centroid.x - 2.0).abs().total_cmp(&(b.centroid.x - 2.0).abs()).then(a.centroid.z.total_cmp(&b.centroid.z)))
+        .unwrap();
     let in_beam = pane.centroid.as_dvec3() - sun.direction * 0.5;
     let floor_patch = in_beam - sun.direction * (in_beam.z / sun.direction.z);
     assert!(model.sun_irradiance(in_beam, sun.direction, &sun) > 0.0, "the eye is in the beam");
@@ -373,7 +386,8 @@ f 19 20 14 17
 ";
     std::fs::write(dir.join("model.obj"), obj).unwrap();
     std::fs::write(dir.join("model.mtl"), "newmtl ground\nKd 0.3 0.3 0.3\nnewmtl wall\nKd 0.6 0.6 0.6\n").unwrap();
-    let scene_text = "name = \"Non-manifold\"\n[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n[model]\nobj = \"model.obj\"\n";
+    let scene_text =
+        "name = \"Non-manifold\"\n[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n[model]\nobj = \"model.obj\"\n";
     std::fs::write(dir.join("scene.toml"), scene_text).unwrap();
     let path = dir.join("scene.toml");
     let views = [
@@ -392,9 +406,15 @@ f 19 20 14 17
 /// rises after sunrise and peaks around noon.
 #[test]
 fn the_day_series_of_a_sensor_follows_the_sun() {
-    use heliodon::viewer::sensors::{DAY_STEPS, day_series};
+    use heliodon::day::{DAY_STEPS, day_series};
     let scene = Arc::new(load_scene(&heliodon::bundled_scene("test_room"), &PanelCatalog::new()).unwrap().scene);
-    let settings = heliodon::light::LightSettings { rays_per_patch: 32, rays_per_sensor: 256, sun_samples_per_patch: 4, area_sensor_sun_grid: 4, ..Default::default() };
+    let settings = heliodon::light::LightSettings {
+        rays_per_patch: 32,
+        rays_per_sensor: 256,
+        sun_samples_per_patch: 4,
+        area_sensor_sun_grid: 4,
+        ..Default::default()
+    };
     let model = Arc::new(LightModel::precompute(scene.clone(), settings).unwrap());
     let centre = scene.sensors.iter().position(|s| s.name == "room-centre").unwrap();
     let values = day_series(&model, centre, &scene.site, Date::new(2026, 3, 21).unwrap(), &SkySpec::Overcast);
@@ -441,30 +461,29 @@ fn material_edits_relight_and_impossible_ones_are_refused() {
 /// be gone back to.
 #[test]
 fn camera_requests_move_the_camera_and_save_views() {
-    use heliodon::viewer::camera::CadCamera;
-    use heliodon::viewer::ui::{CameraRequest, UiState, apply_camera_request};
+    use heliodon::viewer::camera::{CadCamera, CameraControl, CameraRequest, apply_camera_request};
 
     let mut app = headless_app();
-    app.init_resource::<UiState>().add_systems(Update, apply_camera_request);
+    app.init_resource::<CameraControl>().add_systems(Update, apply_camera_request);
     open(&mut app, heliodon::bundled_scene("test_room")).unwrap();
     let camera = app.world_mut().spawn(CadCamera::looking(Vec3::new(2.0, 5.0, 1.6), Vec3::new(2.0, 0.0, 1.2))).id();
     let scene = app.world().resource::<ActiveScene>().scene.clone().unwrap();
     let (centre, distance) = heliodon::render::framing(scene.bounds, heliodon::scene::DEFAULT_FOV);
-    app.world_mut().resource_mut::<UiState>().camera_request = Some(CameraRequest::Top);
+    app.world_mut().resource_mut::<CameraControl>().request = Some(CameraRequest::Top);
     app.update();
     let top = *app.world().get::<CadCamera>(camera).unwrap();
     assert!((top.focus - centre).length() < 1e-5 && (top.distance - distance).abs() < 1e-4);
     assert!(top.eye().z > centre.z + 0.99 * distance, "from above: {:?}", top.eye());
-    app.world_mut().resource_mut::<UiState>().camera_request = Some(CameraRequest::Save);
+    app.world_mut().resource_mut::<CameraControl>().request = Some(CameraRequest::Save);
     app.update();
-    let saved = app.world().resource::<UiState>().saved_views.clone();
+    let saved = app.world().resource::<CameraControl>().saved_views.clone();
     assert_eq!(saved.len(), 1);
     assert!((saved[0].eye - top.eye()).length() < 1e-4);
-    app.world_mut().resource_mut::<UiState>().camera_request = Some(CameraRequest::Front);
+    app.world_mut().resource_mut::<CameraControl>().request = Some(CameraRequest::Front);
     app.update();
     let front = *app.world().get::<CadCamera>(camera).unwrap();
     assert!(front.eye().y < centre.y - 0.99 * distance, "from the south: {:?}", front.eye());
-    app.world_mut().resource_mut::<UiState>().camera_request = Some(CameraRequest::Viewpoint(saved[0].clone()));
+    app.world_mut().resource_mut::<CameraControl>().request = Some(CameraRequest::Viewpoint(saved[0].clone()));
     app.update();
     let back = *app.world().get::<CadCamera>(camera).unwrap();
     assert!((back.eye() - top.eye()).length() < 1e-3);

@@ -2,8 +2,6 @@
 //! copied from ../shared/validation into tests/fixtures/sideroom), and its
 //! physical and numerical promises.
 
-mod common;
-
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -39,7 +37,12 @@ fn validation_room_agrees_with_radiance() {
         .collect();
     let scene = load(&sideroom());
     let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
-    let cases = [("2026-03-21", "12:00", "clear"), ("2026-06-21", "15:00", "overcast"), ("2026-12-21", "09:00", "intermediate"), ("2026-03-21", "12:00", "uniform")];
+    let cases = [
+        ("2026-03-21", "12:00", "clear"),
+        ("2026-06-21", "15:00", "overcast"),
+        ("2026-12-21", "09:00", "intermediate"),
+        ("2026-03-21", "12:00", "uniform"),
+    ];
     let mut errors = Vec::new();
     for (date, time, sky_name) in cases {
         let spec = SkySpec::parse(sky_name, &Default::default()).unwrap();
@@ -47,7 +50,12 @@ fn validation_room_agrees_with_radiance() {
         for reading in &lighting.sensors {
             let reference = references[&(date.to_string(), time.to_string(), sky_name.to_string(), reading.name.clone())];
             let error = if reference >= 50.0 { (reading.total / reference - 1.0).abs() } else { (reading.total - reference).abs() / 250.0 };
-            println!("{date} {time} {sky_name:12} {:15} ref {reference:9.1} got {:9.1} ({:+.1}%)", reading.name, reading.total, 100.0 * (reading.total / reference - 1.0));
+            println!(
+                "{date} {time} {sky_name:12} {:15} ref {reference:9.1} got {:9.1} ({:+.1}%)",
+                reading.name,
+                reading.total,
+                100.0 * (reading.total / reference - 1.0)
+            );
             errors.push(error);
         }
     }
@@ -76,15 +84,29 @@ fn turning_north_on_the_site_matches_turning_the_model_in_its_file() {
     turned.site.north_turn = 90.0;
     let turned = Arc::new(turned);
     let spec = SkySpec::Clear { turbidity: 2.45 };
-    let solve = |scene: &Arc<Scene>| LightModel::precompute(scene.clone(), LightSettings::default()).unwrap().solve(&sky_at(scene, &spec, "2026-12-21", "09:00"), None).sensors;
+    let solve = |scene: &Arc<Scene>| {
+        LightModel::precompute(scene.clone(), LightSettings::default())
+            .unwrap()
+            .solve(&sky_at(scene, &spec, "2026-12-21", "09:00"), None)
+            .sensors
+    };
     let (a, b, facing_south) = (solve(&turned), solve(&in_file), solve(&load(&sideroom())));
     // Direct sun is traced exactly; the rest is Monte Carlo, with samples
     // that do not turn with the model.
     let mut differences = Vec::new();
     let mut largest_change = 0.0f64;
     for ((a, b), south) in a.iter().zip(&b).zip(&facing_south) {
-        println!("{:14} site-turned {:8.1} file-turned {:8.1} (sun {:8.1} / {:8.1}) unturned {:8.1}", a.name, a.total, b.total, a.direct_sun, b.direct_sun, south.total);
-        assert!((a.direct_sun - b.direct_sun).abs() <= 0.01 * b.direct_sun.max(100.0), "{}: direct sun {} vs {}", a.name, a.direct_sun, b.direct_sun);
+        println!(
+            "{:14} site-turned {:8.1} file-turned {:8.1} (sun {:8.1} / {:8.1}) unturned {:8.1}",
+            a.name, a.total, b.total, a.direct_sun, b.direct_sun, south.total
+        );
+        assert!(
+            (a.direct_sun - b.direct_sun).abs() <= 0.01 * b.direct_sun.max(100.0),
+            "{}: direct sun {} vs {}",
+            a.name,
+            a.direct_sun,
+            b.direct_sun
+        );
         differences.push((a.total / b.total - 1.0).abs());
         largest_change = largest_change.max((a.total / south.total - 1.0).abs());
     }
@@ -146,7 +168,10 @@ fn a_sensor_outside_reads_the_open_sky() {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_outside");
     std::fs::create_dir_all(&dir).unwrap();
     let room = std::fs::read_to_string(sideroom()).unwrap();
-    let scene_text = room.replace("[[sensors]]\nname = \"s00\"", "[[sensors]]\nname = \"roof\"\nposition = [2.0, 3.0, 4.0]\nnormal = [0.0, 0.0, 1.0]\n\n[[sensors]]\nname = \"s00\"");
+    let scene_text = room.replace(
+        "[[sensors]]\nname = \"s00\"",
+        "[[sensors]]\nname = \"roof\"\nposition = [2.0, 3.0, 4.0]\nnormal = [0.0, 0.0, 1.0]\n\n[[sensors]]\nname = \"s00\"",
+    );
     std::fs::write(dir.join("scene.toml"), scene_text).unwrap();
     for f in ["model.obj", "model.mtl"] {
         std::fs::copy(sideroom().with_file_name(f), dir.join(f)).unwrap();
@@ -183,7 +208,12 @@ fn sky_light_is_attributed_to_the_windows_it_comes_through() {
     };
     for (sensor, reading) in lighting.sensors.iter().enumerate() {
         let sum: f64 = by_window[sensor].iter().map(|(_, lux)| lux).sum();
-        assert!((sum - reading.direct_sky).abs() <= 1e-9 * reading.direct_sky.max(1.0), "{}: {sum} vs {}", reading.name, reading.direct_sky);
+        assert!(
+            (sum - reading.direct_sky).abs() <= 1e-9 * reading.direct_sky.max(1.0),
+            "{}: {sum} vs {}",
+            reading.name,
+            reading.direct_sky
+        );
         assert!(by_window[sensor].iter().all(|(w, _)| w.is_some()), "{} sees sky without a window", reading.name);
     }
     let index = |name: &str| lighting.sensors.iter().position(|r| r.name == name).unwrap();
@@ -270,7 +300,9 @@ fn the_cache_is_used_and_never_trusted_when_damaged() {
     let mut flipped = good.clone();
     let last = flipped.len() - 3;
     flipped[last] ^= 0x40;
-    for (damage, why) in [(flipped, "checksum mismatch"), (good[..good.len() / 2].to_vec(), "truncated"), (b"hello".to_vec(), "not a heliodon light cache")] {
+    for (damage, why) in
+        [(flipped, "checksum mismatch"), (good[..good.len() / 2].to_vec(), "truncated"), (b"hello".to_vec(), "not a heliodon light cache")]
+    {
         std::fs::write(&path, damage).unwrap();
         let (model, outcome) = precompute_cached(scene.clone(), settings, Some(&dir), &|_| {}).unwrap();
         assert_eq!(outcome, CacheOutcome::Rebuilt(path.clone(), why.to_string()));
@@ -285,110 +317,6 @@ fn the_cache_is_used_and_never_trusted_when_damaged() {
     assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");
     let (_, outcome) = precompute_cached(scene, settings, None, &|_| {}).unwrap();
     assert_eq!(outcome, CacheOutcome::Skipped("disabled".into()));
-}
-
-// ---- the sensors command -------------------------------------------------------------
-
-fn heliodon(args: &[&str], cache: &Path) -> (i32, String, String) {
-    let out = std::process::Command::new(common::heliodon_exe())
-        .args(args)
-        .env("HELIODON_CACHE_DIR", cache)
-        .output()
-        .expect("run heliodon");
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
-}
-
-#[test]
-fn sensors_command_prints_the_contract_csv_and_shares_one_precomputation() {
-    let cache = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sensors_cli_cache");
-    let _ = std::fs::remove_dir_all(&cache);
-    let scene_path = sideroom();
-    let scene = scene_path.to_str().unwrap();
-    let args = ["sensors", scene, "--date", "2026-03-21", "--time", "12:00", "--sky", "overcast", "--format", "csv"];
-    let (code, first, err) = heliodon(&args, &cache);
-    assert_eq!(code, 0, "{err}");
-    let lines: Vec<&str> = first.lines().collect();
-    assert_eq!(lines[0], "name,illuminance_lux,direct_sun_lux,direct_sky_lux,indirect_lux");
-    assert_eq!(lines.len(), 1 + 19);
-    for line in &lines[1..] {
-        let f: Vec<&str> = line.split(',').collect();
-        let v: Vec<f64> = f[1..].iter().map(|x| x.parse().unwrap()).collect();
-        assert!(v.iter().all(|x| x.is_finite() && *x >= 0.0));
-        assert!((v[0] - v[1] - v[2] - v[3]).abs() <= 0.2, "parts add up: {line}");
-        assert_eq!(v[1], 0.0, "no sun under an overcast sky");
-    }
-    // The same from the library.
-    let model = LightModel::precompute(load(&scene_path), LightSettings::default()).unwrap();
-    let expected = model.solve(&sky_at(&model.scene, &SkySpec::Overcast, "2026-03-21", "12:00"), None);
-    assert_eq!(lines[1], format!("s00,{:.1},{:.1},{:.1},{:.1}", expected.sensors[0].total, expected.sensors[0].direct_sun, expected.sensors[0].direct_sky, expected.sensors[0].indirect));
-    // A second run reads the cache and says the same.
-    let (_, second, _) = heliodon(&args, &cache);
-    assert_eq!(first, second);
-    assert!(std::fs::read_dir(&cache).unwrap().count() == 1);
-    // Several times and dates in one call.
-    let (code, many, _) = heliodon(&["sensors", scene, "--date", "2026-03-21,2026-06-21", "--time", "09:00,12:00", "--sky", "clear", "--format", "csv"], &cache);
-    assert_eq!(code, 0);
-    let rows: Vec<&str> = many.lines().collect();
-    assert_eq!(rows[0], "date,time,name,illuminance_lux,direct_sun_lux,direct_sky_lux,indirect_lux");
-    assert_eq!(rows.len(), 1 + 4 * 19);
-    assert!(rows[1].starts_with("2026-03-21,09:00:00,s00,") && rows[rows.len() - 1].starts_with("2026-06-21,12:00:00,ceiling_centre,"));
-}
-
-#[test]
-fn sensors_command_rejects_bad_input_in_one_line() {
-    let cache = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sensors_cli_cache_bad");
-    let scene_path = sideroom();
-    let scene = scene_path.to_str().unwrap();
-    let cases: [(&[&str], &str); 5] = [
-        (&["sensors", scene, "--date", "2026-03-21", "--time", "12:00", "--sky", "sunny"], "unknown sky 'sunny'"),
-        (&["sensors", scene, "--date", "2026-03-21", "--time", "12:00", "--sky", "perez"], "--sky perez"),
-        (&["sensors", scene, "--date", "2026-03-21", "--time", "12:00", "--sky", "perez", "--dni", "-3", "--dhi", "100"], "non-negative"),
-        (&["sensors", "no/such/scene.toml", "--date", "2026-03-21", "--time", "12:00"], "no/such/scene.toml: cannot read scene file"),
-        (&["sensors", scene, "--date", "2026-03-21", "--time", "25:00"], "--time"),
-    ];
-    for (args, expected) in cases {
-        let (code, out, err) = heliodon(args, &cache);
-        assert_ne!(code, 0, "{args:?}");
-        assert!(out.is_empty(), "{out}");
-        assert_eq!(err.lines().count(), 1, "{err}");
-        assert!(err.starts_with("error: ") && err.contains(expected), "{args:?}: {err}");
-    }
-    // Perez light with the sun down is refused, naming the case.
-    let (code, _, err) = heliodon(&["sensors", scene, "--date", "2026-03-21", "--time", "03:00", "--sky", "perez", "--dni", "100", "--dhi", "50"], &cache);
-    assert_ne!(code, 0);
-    assert!(err.contains("2026-03-21 03:00:00") && err.contains("below the horizon"), "{err}");
-}
-
-#[test]
-fn export_radiance_writes_the_same_model_and_sky() {
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("export_test_room");
-    let _ = std::fs::remove_dir_all(&out);
-    let scene_path = heliodon::bundled_scene("test_room");
-    let status = std::process::Command::new(common::heliodon_exe())
-        .args(["export-radiance", scene_path.to_str().unwrap(), "--date", "2026-03-21", "--time", "10:00", "--sky", "clear", "--out", out.to_str().unwrap()])
-        .status()
-        .unwrap();
-    assert!(status.success());
-    let scene = load(&scene_path);
-    let rad = std::fs::read_to_string(out.join("scene.rad")).unwrap();
-    assert_eq!(rad.matches(" polygon ").count(), scene.triangles.len());
-    assert!(rad.contains("void glass m_glass\n0\n0\n3 0.9"), "Radiance transmissivity of 88% glass is 0.96");
-    let sky_rad = std::fs::read_to_string(out.join("sky.rad")).unwrap();
-    let sky = sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-03-21", "10:00");
-    let (zenith, f2) = sky.gensky_arguments().unwrap();
-    assert!(sky_rad.contains(&format!("7 1 {zenith:.9e} {:.9e} {f2:.9e}", sky.ground_radiance)), "{sky_rad}");
-    assert!(sky_rad.contains(&format!("3 {r:.6e} {r:.6e} {r:.6e}", r = sky.sun.unwrap().radiance)));
-    let points = std::fs::read_to_string(out.join("sensors.pts")).unwrap();
-    let index = std::fs::read_to_string(out.join("sensors.txt")).unwrap();
-    let expected: usize = scene.sensors.iter().map(|s| if s.size.is_some() { 16 } else { 1 }).sum();
-    assert_eq!(points.lines().count(), expected);
-    assert_eq!(index.lines().count(), scene.sensors.len());
-    assert!(std::fs::read_to_string(out.join("run.sh")).unwrap().contains("rtrace -h -I -ab 16"));
-    // The floor sensor lies on the floor: it is exported lifted 1 cm, as heliodon reads it.
-    let floor = index.lines().position(|l| l.starts_with("floor-centre ")).unwrap();
-    let first_point: usize = index.lines().take(floor).map(|l| l.split(' ').nth(1).unwrap().parse::<usize>().unwrap()).sum();
-    let z: f64 = points.lines().nth(first_point).unwrap().split(' ').nth(2).unwrap().parse().unwrap();
-    assert!((z - 0.01).abs() < 1e-6, "{z}");
 }
 
 #[test]

@@ -1,13 +1,16 @@
 //! Scene loading without Bevy: the bundled scenes against values known from
-//! their generator, every kind of bad input, and the `info` command line.
+//! their generator and every kind of bad input (the command line is tested
+//! in app/tests/cli.rs).
 
-mod common;
+#[path = "support/fixture.rs"]
+mod fixture;
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
 use heliodon::panel::PanelCatalog;
 use heliodon::scene::{LoadedScene, MaterialKind, SceneError, load_scene};
+
+use fixture::{Fixture, OBJ, SITE, fixture, scene_toml};
 
 fn no_panels() -> PanelCatalog {
     PanelCatalog::new()
@@ -131,26 +134,13 @@ fn living_room_maps_centimetres_y_up_and_turned_north() {
 
 // ---- bad input -------------------------------------------------------------
 
-/// A throwaway scene folder with the given files.
-struct Fixture {
-    dir: PathBuf,
+/// Loading a fixture's scene.
+trait Loads {
+    fn load(&self) -> Result<LoadedScene, SceneError>;
+    fn error(&self) -> SceneError;
 }
 
-impl Fixture {
-    fn new(name: &str, files: &[(&str, &str)]) -> Self {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("bad_input").join(name);
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        for (file, text) in files {
-            std::fs::write(dir.join(file), text).unwrap();
-        }
-        Self { dir }
-    }
-
-    fn scene(&self) -> PathBuf {
-        self.dir.join("scene.toml")
-    }
-
+impl Loads for Fixture {
     fn load(&self) -> Result<LoadedScene, SceneError> {
         load_scene(&self.scene(), &no_panels())
     }
@@ -161,18 +151,6 @@ impl Fixture {
             Err(e) => e,
         }
     }
-}
-
-const SITE: &str = "[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n";
-const MTL: &str = "newmtl wall\nKd 0.5 0.5 0.5\n\nnewmtl glass\nd 0.12\n";
-const OBJ: &str = "mtllib room.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl wall\nf 1 2 3\nusemtl glass\nf 1 3 4\n";
-
-fn scene_toml(extra: &str) -> String {
-    format!("name = \"bad\"\n{SITE}\n[model]\nobj = \"room.obj\"\n{extra}")
-}
-
-fn fixture(name: &str, toml: &str, obj: &str) -> Fixture {
-    Fixture::new(name, &[("scene.toml", toml), ("room.obj", obj), ("room.mtl", MTL)])
 }
 
 #[test]
@@ -320,92 +298,4 @@ fn sensor_names_are_unique_and_grids_non_empty() {
     let grid = "\n[[sensor_grids]]\nname = \"g\"\nmin = [0, 0]\nmax = [0.2, 1]\nheight = 0.8\nspacing = 0.5\n";
     let f = fixture("empty_grid", &scene_toml(grid), OBJ);
     assert_eq!(f.error().location.key.as_deref(), Some("sensor_grids[0].max"));
-}
-
-// ---- command line ------------------------------------------------------------
-
-fn heliodon(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(common::heliodon_exe())
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run heliodon");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-#[test]
-fn info_summarises_each_bundled_scene() {
-    let (code, out, err) = heliodon(&["info", "assets/scenes/test_room/scene.toml"]);
-    assert_eq!(code, 0, "{err}");
-    assert!(err.is_empty(), "{err}");
-    for expected in [
-        "scene      Small test room",
-        "triangles  80",
-        "  diffuse  3: ",
-        "  glass    1: glass τ=0.88",
-        "windows    6, 4.59 m² in all",
-        "facing S (azimuth 180°)",
-        "sensors    65 (3 point, 2 area, grids: workplane 60)",
-        "latitude 42.3600°, longitude -71.0600°, UTC-5",
-    ] {
-        assert!(out.contains(expected), "missing {expected:?} in\n{out}");
-    }
-    let patches: usize = out
-        .lines()
-        .find_map(|l| l.strip_prefix("patches    "))
-        .and_then(|l| l.split_whitespace().next())
-        .and_then(|n| n.parse().ok())
-        .expect("patch line");
-    assert!(patches > 400, "{out}");
-    let (code, out, _) = heliodon(&["info", "assets/scenes/office/scene.toml"]);
-    assert_eq!(code, 0);
-    assert!(out.contains("windows    12, 24.88 m² in all") && out.contains("facing W (azimuth 270°)"), "{out}");
-    let (code, out, _) = heliodon(&["info", "assets/scenes/living_room/scene.toml"]);
-    assert_eq!(code, 0);
-    assert!(out.contains("up Y, scale 0.01 m/unit") && out.contains("windows    16"), "{out}");
-}
-
-#[test]
-fn cli_errors_are_one_line_and_non_zero() {
-    let f = fixture("cli_kind", &scene_toml("\n[materials.wall]\nkind = \"stone\"\n"), OBJ);
-    let scene = f.scene();
-    let (code, out, err) = heliodon(&["info", scene.to_str().unwrap()]);
-    assert_ne!(code, 0);
-    assert!(out.is_empty());
-    assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(err.starts_with(&format!("error: {}:11: materials.wall.kind: unknown material kind 'stone'", scene.display())), "{err}");
-    let (code, _, err) = heliodon(&["info", "no/such/scene.toml"]);
-    assert_ne!(code, 0);
-    assert_eq!(err.trim_end(), "error: no/such/scene.toml: cannot read scene file: not found");
-    let (code, _, err) = heliodon(&["info", "assets/scenes/test_room/scene.toml", "--bogus"]);
-    assert_eq!(code, 2);
-    assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(err.contains("--bogus"), "{err}");
-    let (code, _, err) = heliodon(&["info"]);
-    assert_eq!(code, 2);
-    assert_eq!(err.lines().count(), 1, "{err}");
-    // Warnings go to stderr and do not fail the command.
-    let f = fixture("cli_warning", &scene_toml("\n[materials.marble]\nkind = \"diffuse\"\nreflectance = 0.7\n"), OBJ);
-    let (code, _, err) = heliodon(&["info", f.scene().to_str().unwrap()]);
-    assert_eq!(code, 0);
-    assert!(err.starts_with("warning: ") && err.contains("materials.marble"), "{err}");
-}
-
-#[test]
-fn help_lists_only_what_exists() {
-    let (code, out, _) = heliodon(&["--help"]);
-    assert_eq!(code, 0);
-    // Subcommands arrive with their features: none is listed before it exists.
-    let commands: Vec<&str> = out
-        .lines()
-        .skip_while(|l| !l.starts_with("Commands:"))
-        .skip(1)
-        .take_while(|l| l.starts_with("  "))
-        .filter_map(|l| l.split_whitespace().next())
-        .collect();
-    assert_eq!(commands, ["view", "info", "sensors", "export-radiance", "render", "sun", "help"], "{out}");
 }

@@ -2,8 +2,6 @@
 //! (tests/fixtures/spa_pvlib.csv, made by tools/make_spa_fixture.py), and the
 //! gensky/gendaylit vectors of ../shared/reference/skies.md.
 
-mod common;
-
 use std::f64::consts::PI;
 
 use heliodon::site::Site;
@@ -65,12 +63,15 @@ fn gensky(spec: SkySpec, altitude: f64) -> Sky {
     Sky::new(&spec, altitude, 180.0, 0.2, 0).unwrap()
 }
 
+/// One row of gensky's printed vectors: sky, sun altitude, then as printed
+/// A2 (zenith), A3 (ground), F2, the solar radiance and the ambient value.
+type GenskyRow<'a> = (&'a SkySpec, f64, &'a str, &'a str, Option<&'a str>, Option<&'a str>, &'a str);
+
 #[test]
 fn gensky_reference_vectors() {
     let clear = SkySpec::Clear { turbidity: 2.45 };
     let inter = SkySpec::Intermediate { turbidity: 2.45 };
-    // sky, altitude, A2 (zenith), A3 (ground), F2, solar, ambient
-    let rows: [(&SkySpec, f64, &str, &str, Option<&str>, Option<&str>, &str); 11] = [
+    let rows: [GenskyRow; 11] = [
         (&clear, 10.0, "3.228", "2.926", Some("0.2946"), Some("2.167e6"), "7.4"),
         (&clear, 30.0, "6.312", "14.31", Some("0.3986"), Some("6.151e6"), "12.8"),
         (&clear, 45.0, "9.563", "21.24", Some("0.5707"), Some("6.772e6"), "14.8"),
@@ -155,7 +156,11 @@ fn integrated_horizontal_irradiance_matches_radiance() {
         let (_, horizontal) = integrate_hemisphere(|d| sky.radiance(d), (400, 800));
         let error = horizontal / reference - 1.0;
         let claimed = horizontal / sky.diffuse_horizontal - 1.0;
-        println!("{line}: heliodon {horizontal:9.4} ({:+.3}% vs rtrace; {:+.2}% vs the model's own diffuse level)", 100.0 * error, 100.0 * claimed);
+        println!(
+            "{line}: heliodon {horizontal:9.4} ({:+.3}% vs rtrace; {:+.2}% vs the model's own diffuse level)",
+            100.0 * error,
+            100.0 * claimed
+        );
         if error.abs() > worst.0 {
             worst = (error.abs(), line.to_string());
         }
@@ -186,9 +191,39 @@ fn perez_spec(dni: f64, dhi: f64) -> SkySpec {
 fn gendaylit_reference_vectors() {
     // -ang ALT AZ (gensky azimuth: from south, west positive) -W DNI DHI
     let rows = [
-        (45.0, 0.0, 700.0, 150.0, "4.1021", "0.1497", "5.741e6", ["4.200e1", "2.290e1"], [-0.987797, -0.310477, 13.033068, -3.460981, 0.236428]),
-        (20.0, 90.0, 200.0, 100.0, "1.6900", "0.2050", "1.365e6", ["2.699e1", "4.371"], [-1.237890, -0.542325, 11.263139, -3.236217, 0.037025]),
-        (60.0, -30.0, 850.0, 100.0, "8.3950", "0.0815", "7.232e6", ["3.426e1", "3.118e1"], [-0.984808, -0.200923, 22.074406, -5.904044, 1.338957]),
+        (
+            45.0,
+            0.0,
+            700.0,
+            150.0,
+            "4.1021",
+            "0.1497",
+            "5.741e6",
+            ["4.200e1", "2.290e1"],
+            [-0.987797, -0.310477, 13.033068, -3.460981, 0.236428],
+        ),
+        (
+            20.0,
+            90.0,
+            200.0,
+            100.0,
+            "1.6900",
+            "0.2050",
+            "1.365e6",
+            ["2.699e1", "4.371"],
+            [-1.237890, -0.542325, 11.263139, -3.236217, 0.037025],
+        ),
+        (
+            60.0,
+            -30.0,
+            850.0,
+            100.0,
+            "8.3950",
+            "0.0815",
+            "7.232e6",
+            ["3.426e1", "3.118e1"],
+            [-0.984808, -0.200923, 22.074406, -5.904044, 1.338957],
+        ),
         (30.0, 0.0, 0.0, 200.0, "1.0000", "0.2817", "0", ["1.980e1", "6.686"], [0.583195, -0.443937, 1.606202, -0.988127, 0.037204]),
     ];
     for (alt, az, dni, dhi, eps, delta, solar, [norm, ground], coefficients) in rows {
@@ -244,7 +279,8 @@ fn cie_skies_are_relative_to_the_zenith_and_type_5_is_uniform() {
             assert!((horizontal * 179.0 / 20_000.0 - 1.0).abs() < 0.002, "type {standard_type} at {alt}°: {}", horizontal * 179.0);
         }
     }
-    let uniform = Sky::new(&SkySpec::Cie { standard_type: 5, diffuse_illuminance: 10_000.0, direct_illuminance: 0.0 }, 30.0, 90.0, 0.0, 0).unwrap();
+    let uniform =
+        Sky::new(&SkySpec::Cie { standard_type: 5, diffuse_illuminance: 10_000.0, direct_illuminance: 0.0 }, 30.0, 90.0, 0.0, 0).unwrap();
     for (alt, az) in [(89.0, 0.0), (60.0, 90.0), (45.0, 200.0), (30.0, 300.0)] {
         let r = uniform.radiance(direction_from_angles(alt, az));
         assert!((r / uniform.zenith_radiance - 1.0).abs() < 1e-3, "{alt} {az}: {r}");
@@ -262,7 +298,8 @@ fn patch_integration_conserves_the_sky() {
         gensky(SkySpec::Intermediate { turbidity: 2.45 }, 25.0),
         gensky(SkySpec::Overcast, 50.0),
         Sky::new(&perez_spec(700.0, 150.0), 45.0, 200.0, 0.2, 172).unwrap(),
-        Sky::new(&SkySpec::Cie { standard_type: 12, diffuse_illuminance: 15_000.0, direct_illuminance: 60_000.0 }, 55.0, 160.0, 0.2, 0).unwrap(),
+        Sky::new(&SkySpec::Cie { standard_type: 12, diffuse_illuminance: 15_000.0, direct_illuminance: 60_000.0 }, 55.0, 160.0, 0.2, 0)
+            .unwrap(),
     ];
     for patches in [SkyPatches::tregenza(), SkyPatches::reinhart(4)] {
         for sky in &skies {
@@ -308,68 +345,4 @@ fn bad_sky_input_is_one_clear_line() {
         assert!(!message.contains('\n'));
     }
     assert_eq!(SkySpec::parse("turbid", &none).unwrap(), SkySpec::Clear { turbidity: 5.0 });
-}
-
-// ---- command line -----------------------------------------------------------------------
-
-fn heliodon(args: &[&str]) -> (i32, String, String) {
-    let out = std::process::Command::new(common::heliodon_exe()).args(args).output().expect("run heliodon");
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
-}
-
-const BOSTON: [&str; 6] = ["--latitude", "42.36", "--longitude", "-71.06", "--timezone", "-5"];
-
-#[test]
-fn sun_command_prints_the_contract_formats() {
-    let mut args = vec!["sun"];
-    args.extend(BOSTON);
-    args.extend(["--date", "2026-03-21", "--time", "12:00"]);
-    let site = Site::new(42.36, -71.06, -5.0);
-    let expected = solar_position(&site, &LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() });
-
-    let (code, out, err) = heliodon(&[args.as_slice(), &["--format", "csv"]].concat());
-    assert_eq!(code, 0, "{err}");
-    let lines: Vec<&str> = out.lines().collect();
-    assert_eq!(lines[0], "altitude_deg,azimuth_deg");
-    assert_eq!(lines.len(), 2);
-    let values: Vec<f64> = lines[1].split(',').map(|v| v.parse().unwrap()).collect();
-    assert!((values[0] - expected.altitude).abs() < 1e-6 && (values[1] - expected.azimuth).abs() < 1e-6);
-
-    let (code, out, _) = heliodon(&[args.as_slice(), &["--format", "json"]].concat());
-    assert_eq!(code, 0);
-    assert_eq!(out.trim(), format!("{{\"altitude_deg\": {:.6}, \"azimuth_deg\": {:.6}}}", expected.altitude, expected.azimuth));
-
-    let (code, out, _) = heliodon(&args);
-    assert_eq!(code, 0);
-    assert!(out.contains(&format!("altitude   {:9.4}°", expected.altitude)), "{out}");
-
-    let mut day = vec!["sun"];
-    day.extend(BOSTON);
-    day.extend(["--date", "2026-03-21", "--day", "--format", "csv"]);
-    let (code, out, _) = heliodon(&day);
-    assert_eq!(code, 0);
-    let rows: Vec<&str> = out.lines().collect();
-    assert_eq!(rows[0], "event,time,altitude_deg,azimuth_deg");
-    assert!(rows[1].starts_with("sunrise,05:45:42,") && rows[2].starts_with("noon,11:51:19,") && rows[3].starts_with("sunset,17:57:41,"), "{out}");
-}
-
-#[test]
-fn sun_command_rejects_bad_input_in_one_line() {
-    let cases: [(&[&str], &str); 8] = [
-        (&["--latitude", "95", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21", "--time", "12:00"], "--latitude"),
-        (&["--latitude", "10", "--longitude", "-181", "--timezone", "0", "--date", "2026-03-21", "--time", "12:00"], "--longitude"),
-        (&["--latitude", "10", "--longitude", "0", "--timezone", "-15", "--date", "2026-03-21", "--time", "12:00"], "--timezone"),
-        (&["--latitude", "10", "--longitude", "0", "--timezone", "0", "--date", "2026-02-30", "--time", "12:00"], "February 2026 has 28 days"),
-        (&["--latitude", "10", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21", "--time", "24:01"], "outside 00:00-24:00"),
-        (&["--latitude", "10", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21", "--time", "7pm"], "--time"),
-        (&["--latitude", "10", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21"], "--time"),
-        (&["--latitude", "nan", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21", "--time", "12:00"], "--latitude"),
-    ];
-    for (args, expected) in cases {
-        let (code, out, err) = heliodon(&[&["sun"], args].concat());
-        assert_eq!(code, 2, "{args:?}");
-        assert!(out.is_empty());
-        assert_eq!(err.lines().count(), 1, "{err}");
-        assert!(err.starts_with("error: ") && err.contains(expected), "{args:?}: {err}");
-    }
 }

@@ -1,20 +1,19 @@
 //! The `heliodon` executable: the command line of the heliodon crate with
-//! the built-in panels (plugins/) registered in every app it makes.
+//! the built-in panels (plugins/) known to every scene it loads.
 
 use std::process::ExitCode;
 
-use heliodon::bevy::prelude::App;
+use heliodon::panel::PanelCatalog;
 
-/// The built-in panels, added the way any app adds panel plugins.
-fn add_builtin_panels(app: &mut App) {
-    app.add_plugins((
-        heliodon_prismatic::PrismaticPlugin,
-        heliodon_laser_cut::LaserCutPlugin,
-        heliodon_venetian::VenetianPlugin,
-        heliodon_bsdf::BsdfPlugin,
-    ));
+/// The built-in panels, registered the way any app registers panel types.
+fn builtin_panels() -> PanelCatalog {
+    PanelCatalog::new()
+        .with(heliodon_prismatic::Prismatic)
+        .with(heliodon_laser_cut::LaserCut)
+        .with(heliodon_venetian::Venetian)
+        .with(heliodon_bsdf::Bsdf)
 }
 
 fn main() -> ExitCode {
-    heliodon::cli::main(add_builtin_panels)
+    heliodon::cli::main(builtin_panels())
 }

@@ -7,119 +7,30 @@ mod quad_obj;
 
 use quad_obj::QuadObj;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use heliodon::bevy::prelude::App;
-use heliodon::ecs::panel_catalog;
+use heliodon::ecs::{PanelRegistry, RegisterPanel};
+use heliodon::panel::PanelCatalog;
 use heliodon::scene::{MaterialKind, load_scene};
-use heliodon_panel_fixture::GreyFilterPlugin;
-
-const OBJ: &str = "mtllib room.mtl\nusemtl floor\nv 0 0 0\nv 4 0 0\nv 4 6 0\nv 0 6 0\nf 1 2 3 4\nusemtl upper\nv 0 0 2\nv 4 0 2\nv 4 0 3\nv 0 0 3\nf 5 6 7 8\n";
-const MTL: &str = "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl upper\nKd 0.5 0.5 0.5\n";
-
-/// A scene whose material `upper` is the given panel table body.
-fn scene(name: &str, upper: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("panels_{name}"));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("room.obj"), OBJ).unwrap();
-    std::fs::write(dir.join("room.mtl"), MTL).unwrap();
-    let text = format!(
-        "name = \"Panel room\"\n[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n[model]\nobj = \"room.obj\"\n\n[materials.upper]\nkind = \"panel\"\n{upper}"
-    );
-    std::fs::write(dir.join("scene.toml"), text).unwrap();
-    dir.join("scene.toml")
-}
-
-fn heliodon(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_heliodon"))
-        .args(args)
-        .output()
-        .expect("run heliodon");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
+use heliodon_panel_fixture::GreyFilter;
 
 #[test]
 fn a_panel_from_a_test_only_crate_is_found_by_name() {
-    let path = scene("fixture", "panel = \"grey_filter\"\ntransmittance = 0.4\n");
-    let add: fn(&mut App) = |app| {
-        app.add_plugins(GreyFilterPlugin);
-    };
-    let loaded = load_scene(&path, &panel_catalog(add)).expect("the fixture's panel is registered");
-    let upper = loaded
-        .scene
-        .materials
-        .iter()
-        .find(|m| m.name == "upper")
-        .unwrap();
-    let MaterialKind::Panel { panel, model, .. } = &upper.kind else {
-        panic!("{upper:?}")
-    };
+    let path = room("fixture", Some("panel = \"grey_filter\"\ntransmittance = 0.4\n"));
+    // Registered in an app with the one line a modder writes.
+    let mut app = App::new();
+    app.register_panel(GreyFilter);
+    let catalog = app.world().resource::<PanelRegistry>().catalog();
+    let loaded = load_scene(&path, &catalog).expect("the fixture's panel is registered");
+    let window = loaded.scene.materials.iter().find(|m| m.name == "window").unwrap();
+    let MaterialKind::Panel { panel, model, .. } = &window.kind else { panic!("{window:?}") };
     assert_eq!(panel, "grey_filter");
     let response = model.0.response(heliodon::glam::DVec3::new(0.0, -0.6, 0.8));
     assert!((response.transmitted() - 0.4).abs() < 1e-12);
     assert_eq!(loaded.scene.windows.len(), 1);
     // Without the plugin the same file names the panels that are known.
-    let error = load_scene(&path, &panel_catalog(|_| {}))
-        .unwrap_err()
-        .to_string();
-    assert!(
-        error.contains("no panel named 'grey_filter' is registered (registered: none)"),
-        "{error}"
-    );
-}
-
-#[test]
-fn the_executable_knows_the_built_in_panels() {
-    let path = scene(
-        "prismatic",
-        "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n",
-    );
-    let (code, out, err) = heliodon(&["info", path.to_str().unwrap()]);
-    assert_eq!(code, 0, "{err}");
-    assert!(out.contains("panel    1"), "{out}");
-
-    let path = scene("unknown", "panel = \"lenticular\"\n");
-    let (code, _, err) = heliodon(&["info", path.to_str().unwrap()]);
-    assert_ne!(code, 0);
-    assert_eq!(err.trim().lines().count(), 1, "{err}");
-    assert!(err.contains("scene.toml:11: materials.upper.panel: no panel named 'lenticular' is registered (registered: bsdf, laser_cut, prismatic, venetian)"), "{err}");
-}
-
-#[test]
-fn bad_panel_keys_give_one_line_naming_the_key() {
-    let cases = [
-        (
-            "range",
-            "panel = \"prismatic\"\nfacet_angles = [40.0, 95.0]\n",
-            "scene.toml:12: materials.upper.facet_angles: 95 is outside 0..89",
-        ),
-        (
-            "missing",
-            "panel = \"prismatic\"\n",
-            "scene.toml:9: materials.upper.facet_angles: is required",
-        ),
-        (
-            "unknown",
-            "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\nfacet_count = 3\n",
-            "materials.upper.facet_count: is not a key of panel 'prismatic'",
-        ),
-        (
-            "type",
-            "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\nrefractive_index = \"acrylic\"\n",
-            "materials.upper.refractive_index: must be a number",
-        ),
-    ];
-    for (name, body, expected) in cases {
-        let path = scene(name, body);
-        let (code, _, err) = heliodon(&["info", path.to_str().unwrap()]);
-        assert_ne!(code, 0, "{name}");
-        assert_eq!(err.trim().lines().count(), 1, "{name}: {err}");
-        assert!(err.contains(expected), "{name}: {err}");
-    }
+    let error = load_scene(&path, &PanelCatalog::new()).unwrap_err().to_string();
+    assert!(error.contains("no panel named 'grey_filter' is registered (registered: none)"), "{error}");
 }
 
 /// A closed 4 × 6 × 3 m room with a 2 × 1 m opening in its south wall,
@@ -135,80 +46,26 @@ fn room_with(name: &str, window: Option<&str>, overhang: bool) -> PathBuf {
     std::fs::create_dir_all(&dir).unwrap();
     let mut obj = QuadObj::new("room.mtl");
     let (w, d, h) = (4.0, 6.0, 3.0);
-    obj.quad(
-        "floor",
-        [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]],
-    );
+    obj.quad("floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
     obj.quad("wall", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
     obj.quad("wall", [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]]);
-    obj.quad(
-        "wall",
-        [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]],
-    );
+    obj.quad("wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
     obj.quad("wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
     // South wall around the opening x 1-3, z 1-2.
-    obj.quad(
-        "wall",
-        [
-            [0.0, 0.0, 0.0],
-            [w, 0.0, 0.0],
-            [w, 0.0, 1.0],
-            [0.0, 0.0, 1.0],
-        ],
-    );
-    obj.quad(
-        "wall",
-        [[0.0, 0.0, 2.0], [w, 0.0, 2.0], [w, 0.0, h], [0.0, 0.0, h]],
-    );
-    obj.quad(
-        "wall",
-        [
-            [0.0, 0.0, 1.0],
-            [1.0, 0.0, 1.0],
-            [1.0, 0.0, 2.0],
-            [0.0, 0.0, 2.0],
-        ],
-    );
-    obj.quad(
-        "wall",
-        [
-            [3.0, 0.0, 1.0],
-            [w, 0.0, 1.0],
-            [w, 0.0, 2.0],
-            [3.0, 0.0, 2.0],
-        ],
-    );
+    obj.quad("wall", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, 0.0, 1.0], [0.0, 0.0, 1.0]]);
+    obj.quad("wall", [[0.0, 0.0, 2.0], [w, 0.0, 2.0], [w, 0.0, h], [0.0, 0.0, h]]);
+    obj.quad("wall", [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 0.0, 2.0], [0.0, 0.0, 2.0]]);
+    obj.quad("wall", [[3.0, 0.0, 1.0], [w, 0.0, 1.0], [w, 0.0, 2.0], [3.0, 0.0, 2.0]]);
     if window.is_some() {
-        obj.quad(
-            "window",
-            [
-                [1.0, 0.0, 1.0],
-                [3.0, 0.0, 1.0],
-                [3.0, 0.0, 2.0],
-                [1.0, 0.0, 2.0],
-            ],
-        );
+        obj.quad("window", [[1.0, 0.0, 1.0], [3.0, 0.0, 1.0], [3.0, 0.0, 2.0], [1.0, 0.0, 2.0]]);
     }
     if overhang {
-        obj.quad(
-            "wall",
-            [
-                [0.5, 0.0, 2.2],
-                [3.5, 0.0, 2.2],
-                [3.5, -1.0, 2.2],
-                [0.5, -1.0, 2.2],
-            ],
-        );
+        obj.quad("wall", [[0.5, 0.0, 2.2], [3.5, 0.0, 2.2], [3.5, -1.0, 2.2], [0.5, -1.0, 2.2]]);
     }
     std::fs::write(dir.join("room.obj"), obj.text()).unwrap();
-    std::fs::write(
-        dir.join("room.mtl"),
-        "newmtl floor\nKd 0.2 0.2 0.2\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl window\nd 0.1\n",
-    )
-    .unwrap();
-    let mut text = String::from(
-        "name = \"Panel room\"\n[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n[model]\nobj = \"room.obj\"\n",
-    );
+    std::fs::write(dir.join("room.mtl"), "newmtl floor\nKd 0.2 0.2 0.2\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl window\nd 0.1\n").unwrap();
+    let mut text =
+        String::from("name = \"Panel room\"\n[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n[model]\nobj = \"room.obj\"\n");
     if let Some(window) = window {
         text.push_str(&format!("\n[materials.window]\nkind = \"panel\"\n{window}"));
     }
@@ -219,40 +76,24 @@ fn room_with(name: &str, window: Option<&str>, overhang: bool) -> PathBuf {
     dir.join("scene.toml")
 }
 
-fn all_panels(app: &mut App) {
-    app.add_plugins((
-        GreyFilterPlugin,
-        heliodon_prismatic::PrismaticPlugin,
-        heliodon_laser_cut::LaserCutPlugin,
-        heliodon_venetian::VenetianPlugin,
-        heliodon_bsdf::BsdfPlugin,
-    ));
+fn all_panels() -> PanelCatalog {
+    PanelCatalog::new()
+        .with(GreyFilter)
+        .with(heliodon_prismatic::Prismatic)
+        .with(heliodon_laser_cut::LaserCut)
+        .with(heliodon_venetian::Venetian)
+        .with(heliodon_bsdf::Bsdf)
 }
 
 fn winter_noon(scene: &heliodon::scene::Scene) -> heliodon::sky::Sky {
     use heliodon::time::{Date, LocalDateTime, TimeOfDay};
-    let when = LocalDateTime {
-        date: Date::new(2026, 12, 21).unwrap(),
-        time: TimeOfDay::from_hours(12.0).unwrap(),
-    };
+    let when = LocalDateTime { date: Date::new(2026, 12, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() };
     let sun = heliodon::sun::solar_position(&scene.site, &when);
-    heliodon::sky::Sky::new(
-        &heliodon::sky::SkySpec::Clear { turbidity: 2.45 },
-        sun.altitude,
-        sun.azimuth,
-        0.2,
-        355,
-    )
-    .unwrap()
+    heliodon::sky::Sky::new(&heliodon::sky::SkySpec::Clear { turbidity: 2.45 }, sun.altitude, sun.azimuth, 0.2, 355).unwrap()
 }
 
 fn quick() -> heliodon::light::LightSettings {
-    heliodon::light::LightSettings {
-        rays_per_patch: 16,
-        rays_per_sensor: 64,
-        sun_samples_per_patch: 64,
-        ..Default::default()
-    }
+    heliodon::light::LightSettings { rays_per_patch: 16, rays_per_sensor: 64, sun_samples_per_patch: 64, ..Default::default() }
 }
 
 /// A panel whose one lobe goes straight on with its whole share passes the
@@ -261,43 +102,24 @@ fn quick() -> heliodon::light::LightSettings {
 #[test]
 fn a_straight_lobe_passes_the_sun_as_an_opening_does() {
     use std::sync::Arc;
-    let catalog = panel_catalog(all_panels);
+    let catalog = all_panels();
     // Direct sun and direct sky at each floor sensor.
     let direct = |path: PathBuf| -> Vec<(f64, f64)> {
         let scene = Arc::new(load_scene(&path, &catalog).unwrap().scene);
         let model = heliodon::light::LightModel::precompute(scene.clone(), quick()).unwrap();
         let lighting = model.solve(&winter_noon(&scene), None);
-        lighting
-            .sensors
-            .iter()
-            .map(|s| (s.direct_sun, s.direct_sky))
-            .collect()
+        lighting.sensors.iter().map(|s| (s.direct_sun, s.direct_sky)).collect()
     };
     let open = direct(room("open", None));
-    let clear = direct(room(
-        "clear",
-        Some("panel = \"grey_filter\"\ntransmittance = 1.0\n"),
-    ));
-    let grey = direct(room(
-        "grey",
-        Some("panel = \"grey_filter\"\ntransmittance = 0.4\n"),
-    ));
-    assert!(
-        open.iter().filter(|e| e.0 > 1000.0).count() >= 2,
-        "the beam reaches the floor sensors: {open:?}"
-    );
+    let clear = direct(room("clear", Some("panel = \"grey_filter\"\ntransmittance = 1.0\n")));
+    let grey = direct(room("grey", Some("panel = \"grey_filter\"\ntransmittance = 0.4\n")));
+    assert!(open.iter().filter(|e| e.0 > 1000.0).count() >= 2, "the beam reaches the floor sensors: {open:?}");
     assert!(open.iter().all(|e| e.1 > 10.0), "the sky is seen: {open:?}");
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * a.max(1.0);
     for ((o, c), g) in open.iter().zip(&clear).zip(&grey) {
         // The sun along the lobe's beam, the sky through the panel's transfer.
-        assert!(
-            close(o.0, c.0) && close(o.1, c.1),
-            "open {o:?} vs clear panel {c:?}"
-        );
-        assert!(
-            close(0.4 * o.0, g.0) && close(0.4 * o.1, g.1),
-            "open {o:?} vs grey panel {g:?}"
-        );
+        assert!(close(o.0, c.0) && close(o.1, c.1), "open {o:?} vs clear panel {c:?}");
+        assert!(close(0.4 * o.0, g.0) && close(0.4 * o.1, g.1), "open {o:?} vs grey panel {g:?}");
     }
 }
 
@@ -307,11 +129,8 @@ fn a_straight_lobe_passes_the_sun_as_an_opening_does() {
 #[test]
 fn sunlight_through_a_prismatic_window_is_conserved() {
     use std::sync::Arc;
-    let path = room(
-        "prismatic",
-        Some("panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n"),
-    );
-    let scene = Arc::new(load_scene(&path, &panel_catalog(all_panels)).unwrap().scene);
+    let path = room("prismatic", Some("panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n"));
+    let scene = Arc::new(load_scene(&path, &all_panels()).unwrap().scene);
     let model = heliodon::light::LightModel::precompute(scene.clone(), quick()).unwrap();
     let sky = winter_noon(&scene);
     let lighting = model.solve(&sky, None);
@@ -322,37 +141,22 @@ fn sunlight_through_a_prismatic_window_is_conserved() {
         .patches
         .iter()
         .enumerate()
-        .filter(|(_, p)| {
-            matches!(
-                scene.materials[p.material as usize].kind,
-                MaterialKind::Diffuse { .. }
-            )
-        })
+        .filter(|(_, p)| matches!(scene.materials[p.material as usize].kind, MaterialKind::Diffuse { .. }))
         .map(|(i, p)| {
-            let inward = if p.normal.as_dvec3().dot(centre - p.centroid.as_dvec3()) > 0.0 {
-                2 * i
-            } else {
-                2 * i + 1
-            };
+            let inward = if p.normal.as_dvec3().dot(centre - p.centroid.as_dvec3()) > 0.0 { 2 * i } else { 2 * i + 1 };
             f64::from(p.area) * lighting.sides[inward].sun
         })
         .sum();
     let sun = sky.sun.unwrap();
     let window = &scene.windows[0];
-    let MaterialKind::Panel { model: panel, .. } = &scene.materials[window.material as usize].kind
-    else {
-        panic!()
-    };
+    let MaterialKind::Panel { model: panel, .. } = &scene.materials[window.material as usize].kind else { panic!() };
     let frame = heliodon::light::PanelFrame::new(heliodon::glam::DVec3::Y, None);
     let incoming = frame.to_panel(-sun.direction);
     let transmitted = panel.0.response(incoming).transmitted();
     let expected = sun.normal_irradiance() * incoming.z * f64::from(window.area) * transmitted;
     println!("landed {landed:.1} W, expected {expected:.1} W (transmitted share {transmitted:.3})");
     assert!(transmitted > 0.5);
-    assert!(
-        (landed / expected - 1.0).abs() < 0.03,
-        "landed {landed} vs {expected}"
-    );
+    assert!((landed / expected - 1.0).abs() < 0.03, "landed {landed} vs {expected}");
 }
 
 /// The renderer draws each panel lobe as a fake sun: the direct-sun image
@@ -371,34 +175,23 @@ fn panel_lobes_are_drawn_where_the_engine_puts_them() {
         ("venetian_room", (2026, 3, 21), 12.0),
         ("bsdf_room", (2026, 3, 21), 10.0),
     ] {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join(format!("../assets/scenes/{room}/scene.toml"));
-        let scene = load_scene(&path, &panel_catalog(all_panels)).unwrap().scene;
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../assets/scenes/{room}/scene.toml"));
+        let scene = load_scene(&path, &all_panels()).unwrap().scene;
         let request = OffscreenRequest {
             scene: path.clone(),
             view: Some(scene.viewpoints[0].clone()),
             width: 320,
             height: 200,
-            when: Some(LocalDateTime {
-                date: Date::new(date.0, date.1, date.2).unwrap(),
-                time: TimeOfDay::from_hours(hours).unwrap(),
-            }),
+            when: Some(LocalDateTime { date: Date::new(date.0, date.1, date.2).unwrap(), time: TimeOfDay::from_hours(hours).unwrap() }),
             sky: Some(heliodon::sky::SkySpec::Clear { turbidity: 2.45 }),
-            settings: RenderSettings {
-                mode: RenderMode::Sun,
-                ..Default::default()
-            },
-            add_panels: all_panels,
+            settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
+            panels: all_panels(),
         };
-        let file = Path::new(env!("CARGO_TARGET_TMPDIR"))
-            .join(format!("sun_{room}_{}_{hours}.png", date.1));
+        let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("sun_{room}_{}_{hours}.png", date.1));
         let result = compare_direct_sun(&request, &file).unwrap();
         println!("{room} {date:?} {hours}: {result} -> {}", file.display());
         assert!(result.lit > 500, "{result}");
-        assert!(
-            result.agreement >= 0.99 && result.within >= 0.99,
-            "{result}"
-        );
+        assert!(result.agreement >= 0.99 && result.within >= 0.99, "{result}");
     }
 }
 
@@ -412,11 +205,7 @@ fn an_overhang_shades_the_lobes_of_a_panel() {
     use heliodon::render::{RenderMode, RenderSettings};
     use heliodon::scene::Viewpoint;
     use heliodon::time::{Date, LocalDateTime, TimeOfDay};
-    let path = room_with(
-        "overhang",
-        Some("panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n"),
-        true,
-    );
+    let path = room_with("overhang", Some("panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n"), true);
     let view = Viewpoint {
         name: "floor".into(),
         eye: heliodon::glam::Vec3::new(2.0, 5.5, 2.5),
@@ -428,42 +217,18 @@ fn an_overhang_shades_the_lobes_of_a_panel() {
         view: Some(view),
         width: 320,
         height: 200,
-        when: Some(LocalDateTime {
-            date: Date::new(2026, 12, 21).unwrap(),
-            time: TimeOfDay::from_hours(12.0).unwrap(),
-        }),
+        when: Some(LocalDateTime { date: Date::new(2026, 12, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() }),
         sky: Some(heliodon::sky::SkySpec::Clear { turbidity: 2.45 }),
-        settings: RenderSettings {
-            mode: RenderMode::Sun,
-            ..Default::default()
-        },
-        add_panels: all_panels,
+        settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
+        panels: all_panels(),
     };
     let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sun_overhang_prismatic.png");
     let result = compare_direct_sun(&request, &file).unwrap();
-    println!(
-        "overhang over a prismatic window: {result} -> {}",
-        file.display()
-    );
+    println!("overhang over a prismatic window: {result} -> {}", file.display());
     assert!(result.lit > 1000, "{result}");
-    assert!(
-        result.agreement >= 0.99 && result.within >= 0.99,
-        "{result}"
-    );
+    assert!(result.agreement >= 0.99 && result.within >= 0.99, "{result}");
     // And the overhang does shade: the same view without it has more sun.
-    let open = OffscreenRequest {
-        scene: room(
-            "no_overhang",
-            Some("panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n"),
-        ),
-        ..request
-    };
-    let unshaded =
-        compare_direct_sun(&open, &file.with_file_name("sun_no_overhang_prismatic.png")).unwrap();
-    assert!(
-        result.lit < unshaded.lit * 9 / 10,
-        "{} lit with the overhang, {} without",
-        result.lit,
-        unshaded.lit
-    );
+    let open = OffscreenRequest { scene: room("no_overhang", Some("panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n")), ..request };
+    let unshaded = compare_direct_sun(&open, &file.with_file_name("sun_no_overhang_prismatic.png")).unwrap();
+    assert!(result.lit < unshaded.lit * 9 / 10, "{} lit with the overhang, {} without", result.lit, unshaded.lit);
 }

@@ -34,11 +34,13 @@ fn view_screenshot_shows_the_panels_and_the_lit_model() {
         (u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2])) / 3
     };
     // The panels: egui's dark grey on both sides, with text on it.
-    let dark = |x0: u32, x1: u32| (x0..x1).flat_map(|x| (0..800).step_by(4).map(move |y| (x, y))).filter(|&(x, y)| luminance(x, y) < 40).count();
+    let dark =
+        |x0: u32, x1: u32| (x0..x1).flat_map(|x| (0..800).step_by(4).map(move |y| (x, y))).filter(|&(x, y)| luminance(x, y) < 40).count();
     assert!(dark(0, 200) > 200 * 200 * 6 / 10 / 4, "left panel");
     assert!(dark(1080, 1280) > 200 * 200 * 6 / 10 / 4, "right panel");
     // The model between them: lit walls and sun patches, not a flat colour.
-    let middle: Vec<u32> = (400..880).step_by(4).flat_map(|x| (100..700).step_by(4).map(move |y| (x, y))).map(|(x, y)| luminance(x, y)).collect();
+    let middle: Vec<u32> =
+        (400..880).step_by(4).flat_map(|x| (100..700).step_by(4).map(move |y| (x, y))).map(|(x, y)| luminance(x, y)).collect();
     let bright = middle.iter().filter(|&&l| l > 200).count();
     let mid = middle.iter().filter(|&&l| (50..200).contains(&l)).count();
     assert!(bright > middle.len() / 50, "sun patches: {bright} of {}", middle.len());
@@ -72,18 +74,12 @@ fn view_screenshot_shows_the_panels_and_the_lit_model() {
     assert!(close > 0.98, "{:.4} of the pixels within 2%", close);
 }
 
-/// A flat (not run-length encoded) Radiance picture, as heliodon writes it.
+/// A Radiance picture, read with `image`'s HDR decoder.
 fn read_hdr(path: &Path) -> (usize, usize, Vec<[f32; 3]>) {
-    let bytes = std::fs::read(path).unwrap();
-    let text_end = bytes.windows(2).position(|w| w == b"\n\n").unwrap() + 2;
-    let size_end = text_end + bytes[text_end..].iter().position(|&b| b == b'\n').unwrap();
-    let size = std::str::from_utf8(&bytes[text_end..size_end]).unwrap();
-    let fields: Vec<&str> = size.split_whitespace().collect();
-    let (height, width): (usize, usize) = (fields[1].parse().unwrap(), fields[3].parse().unwrap());
-    let pixels = bytes[size_end + 1..]
-        .chunks_exact(4)
-        .map(|p| if p[3] == 0 { [0.0; 3] } else { [0, 1, 2].map(|c| (f32::from(p[c]) + 0.5) * 2f32.powi(i32::from(p[3]) - 136)) })
-        .collect::<Vec<_>>();
+    let reader = std::io::BufReader::new(std::fs::File::open(path).unwrap());
+    let image = image::ImageReader::with_format(reader, image::ImageFormat::Hdr).decode().unwrap().into_rgb32f();
+    let (width, height) = (image.width() as usize, image.height() as usize);
+    let pixels: Vec<[f32; 3]> = image.pixels().map(|p| p.0).collect();
     assert_eq!(pixels.len(), width * height, "{}", path.display());
     (width, height, pixels)
 }

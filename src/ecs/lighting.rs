@@ -13,13 +13,13 @@ use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task, block_on, futures_lite::future};
 
 use super::{ActiveScene, HeliodonSystems, LightChanged, SceneSpawned, SunSky};
-use crate::light::{LightModel, LightSettings, Lighting, cache};
+use crate::light::{self, LightModel, Lighting, cache};
 
 pub struct LightingPlugin;
 
 impl Plugin for LightingPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<LightingSettings>()
+        app.init_resource::<LightSettings>()
             .init_resource::<LightCacheDir>()
             .init_resource::<LightEngine>()
             .init_resource::<LightingState>()
@@ -32,9 +32,10 @@ impl Plugin for LightingPlugin {
     }
 }
 
-/// Settings of the light engine for the next precomputation.
+/// The light engine's settings for the next precomputation (the core's
+/// [`light::LightSettings`], as a resource).
 #[derive(Resource, Debug, Clone, Copy, Default, PartialEq)]
-pub struct LightingSettings(pub LightSettings);
+pub struct LightSettings(pub light::LightSettings);
 
 /// Where precomputations are cached (`None`: not at all).
 #[derive(Resource, Debug, Clone, PartialEq)]
@@ -102,7 +103,7 @@ pub struct LightingFailed {
 fn start_precompute(
     mut spawned: MessageReader<SceneSpawned>,
     active: Res<ActiveScene>,
-    settings: Res<LightingSettings>,
+    settings: Res<LightSettings>,
     cache_dir: Res<LightCacheDir>,
     mut engine: ResMut<LightEngine>,
     mut state: ResMut<LightingState>,
@@ -117,9 +118,10 @@ fn start_precompute(
     engine.generation.fetch_add(1, Ordering::SeqCst);
     *state = LightingState::default();
     let dir = cache_dir.0.clone();
-    engine.precompute = Some(AsyncComputeTaskPool::get().spawn(async move {
-        cache::precompute_cached(scene, settings, dir.as_deref(), &|_| {}).map(|(model, _)| model)
-    }));
+    engine.precompute = Some(
+        AsyncComputeTaskPool::get()
+            .spawn(async move { cache::precompute_cached(scene, settings, dir.as_deref(), &|_| {}).map(|(model, _)| model) }),
+    );
 }
 
 fn finish_precompute(mut engine: ResMut<LightEngine>, mut failed: MessageWriter<LightingFailed>) {
@@ -137,7 +139,12 @@ fn finish_precompute(mut engine: ResMut<LightEngine>, mut failed: MessageWriter<
     }
 }
 
-fn start_relight(mut changed: MessageReader<LightChanged>, sun_sky: Option<Res<SunSky>>, state: Res<LightingState>, mut engine: ResMut<LightEngine>) {
+fn start_relight(
+    mut changed: MessageReader<LightChanged>,
+    sun_sky: Option<Res<SunSky>>,
+    state: Res<LightingState>,
+    mut engine: ResMut<LightEngine>,
+) {
     if changed.read().last().is_some() {
         engine.relight_pending = true;
     }

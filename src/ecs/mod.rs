@@ -12,12 +12,12 @@ mod sun_sky;
 use bevy::app::PluginGroupBuilder;
 use bevy::prelude::*;
 
-pub use scene_asset::{AddPanels, PanelRegistry, RegisterPanel, SceneAsset, panel_catalog, SceneLoader, describe_load_failure, scene_asset_path};
+pub use lighting::{LightCacheDir, LightEngine, LightSettings, LightingFailed, LightingPlugin, LightingState, LightingUpdated};
+pub use scene_asset::{PanelRegistry, RegisterPanel, SceneAsset, SceneLoader, describe_load_failure, scene_asset_path};
 pub use scene_plugin::{
-    ActiveScene, EditMaterial, GiveOwnMaterial, MaterialEditRejected, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, ScenePlugin, SceneRoot, SceneSpawned,
-    SceneSurface, SceneSensor, SceneWindow, Site,
+    ActiveScene, EditMaterial, GiveOwnMaterial, MaterialEditRejected, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, ScenePlugin,
+    SceneRoot, SceneSensor, SceneSpawned, SceneSurface, SceneWindow, Site,
 };
-pub use lighting::{LightCacheDir, LightEngine, LightingFailed, LightingPlugin, LightingSettings, LightingState, LightingUpdated};
 pub use sun_sky::{LightChanged, SkyChoice, SkyRejected, SkySubdivision, SolarTime, SunSky, SunSkyPlugin};
 
 /// The simulation plugins, in dependency order.

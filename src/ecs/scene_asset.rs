@@ -32,31 +32,33 @@ impl PanelRegistry {
         self.catalog.write().expect("panel registry lock").register(Arc::new(panel));
     }
 
+    /// Registers every panel type of `catalog`.
+    pub fn register_all(&self, catalog: &PanelCatalog) {
+        self.catalog.write().expect("panel registry lock").extend(catalog);
+    }
+
     /// A snapshot of the registered panel types.
     pub fn catalog(&self) -> PanelCatalog {
         self.catalog.read().expect("panel registry lock").clone()
     }
 }
 
-/// Adds panel plugins to an app: how the command line hands the built-in
-/// panels (and any others) to every app it makes.
-pub type AddPanels = fn(&mut App);
-
-/// The panel types that `add_panels` registers.
-pub fn panel_catalog(add_panels: AddPanels) -> PanelCatalog {
-    let mut app = App::new();
-    add_panels(&mut app);
-    app.world_mut().get_resource_or_init::<PanelRegistry>().catalog()
-}
-
-/// Registering a panel type from a plugin: `app.register_panel(MyPanel)`.
+/// Registering panel types in an app, one line each:
+/// `app.register_panel(MyPanel)`, or a whole catalog with
+/// `app.register_panels(&catalog)`. The panel's crate needs no Bevy.
 pub trait RegisterPanel {
     fn register_panel(&mut self, panel: impl PanelType + 'static) -> &mut Self;
+    fn register_panels(&mut self, catalog: &PanelCatalog) -> &mut Self;
 }
 
 impl RegisterPanel for App {
     fn register_panel(&mut self, panel: impl PanelType + 'static) -> &mut Self {
         self.world_mut().get_resource_or_init::<PanelRegistry>().register(panel);
+        self
+    }
+
+    fn register_panels(&mut self, catalog: &PanelCatalog) -> &mut Self {
+        self.world_mut().get_resource_or_init::<PanelRegistry>().register_all(catalog);
         self
     }
 }
@@ -79,12 +81,7 @@ impl AssetLoader for SceneLoader {
     type Settings = ();
     type Error = SceneError;
 
-    async fn load(
-        &self,
-        reader: &mut dyn Reader,
-        _settings: &(),
-        load_context: &mut LoadContext<'_>,
-    ) -> Result<SceneAsset, SceneError> {
+    async fn load(&self, reader: &mut dyn Reader, _settings: &(), load_context: &mut LoadContext<'_>) -> Result<SceneAsset, SceneError> {
         let scene_path = load_context.path().path().to_path_buf();
         let mut scene_bytes = Vec::new();
         reader

@@ -30,13 +30,7 @@ impl Plugin for ScenePlugin {
             .add_message::<MaterialEditRejected>()
             .configure_sets(
                 Update,
-                (
-                    HeliodonSystems::LoadScene,
-                    HeliodonSystems::SpawnScene,
-                    HeliodonSystems::UpdateSunSky,
-                    HeliodonSystems::Lighting,
-                )
-                    .chain(),
+                (HeliodonSystems::LoadScene, HeliodonSystems::SpawnScene, HeliodonSystems::UpdateSunSky, HeliodonSystems::Lighting).chain(),
             )
             .add_systems(Update, request_scene.in_set(HeliodonSystems::LoadScene))
             .add_systems(Update, (spawn_loaded_scene, report_failed_load, apply_material_edits).in_set(HeliodonSystems::SpawnScene));
@@ -149,11 +143,7 @@ pub struct SceneWindow {
 #[derive(Component, Debug, Clone)]
 pub struct SceneSensor(pub scene::Sensor);
 
-fn request_scene(
-    mut requests: MessageReader<OpenScene>,
-    asset_server: Res<AssetServer>,
-    mut active: ResMut<ActiveScene>,
-) {
+fn request_scene(mut requests: MessageReader<OpenScene>, asset_server: Res<AssetServer>, mut active: ResMut<ActiveScene>) {
     if let Some(OpenScene(path)) = requests.read().last() {
         let handle = asset_server.load(scene_asset_path(path));
         active.pending = Some((path.clone(), handle));
@@ -249,22 +239,13 @@ fn spawn_scene(commands: &mut Commands, scene: &Scene) -> Entity {
         .enumerate()
         .map(|(index, material)| {
             commands
-                .spawn((
-                    SceneMaterial { index: index as u32, material: material.clone() },
-                    Name::new(material.name.clone()),
-                    ChildOf(root),
-                ))
+                .spawn((SceneMaterial { index: index as u32, material: material.clone() }, Name::new(material.name.clone()), ChildOf(root)))
                 .id()
         })
         .collect();
     for (index, surface) in scene.surfaces.iter().enumerate() {
         commands.spawn((
-            SceneSurface {
-                index: index as u32,
-                patches: surface.patches.clone(),
-                area: surface.area,
-                normal: surface.normal,
-            },
+            SceneSurface { index: index as u32, patches: surface.patches.clone(), area: surface.area, normal: surface.normal },
             MaterialOf(materials[surface.material as usize]),
             ChildOf(root),
         ));

@@ -42,10 +42,7 @@ pub struct SolarTime(pub LocalDateTime);
 impl Default for SolarTime {
     /// The March equinox at noon: a neutral first view.
     fn default() -> Self {
-        Self(LocalDateTime {
-            date: Date::new(2026, 3, 21).expect("valid date"),
-            time: TimeOfDay::from_hours(12.0).expect("valid time"),
-        })
+        Self(LocalDateTime { date: Date::new(2026, 3, 21).expect("valid date"), time: TimeOfDay::from_hours(12.0).expect("valid time") })
     }
 }
 

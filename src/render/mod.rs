@@ -8,17 +8,16 @@
 pub mod legend;
 pub mod offscreen;
 pub mod reference;
-pub mod shadow_volume;
 pub mod sun_pass;
 pub mod surfaces;
 
 use std::sync::Arc;
 
 use bevy::camera::Exposure;
+use bevy::camera::Hdr;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
 use bevy::render::render_resource::TextureUsages;
-use bevy::camera::Hdr;
 use bevy::render::view::Msaa;
 
 use crate::ecs::{ActiveScene, HeliodonSystems, LightEngine, LightingState, SunSky};
@@ -29,6 +28,20 @@ use surfaces::{SurfaceLightingPlugin, side_value};
 
 pub struct HeliodonRenderPlugin;
 
+/// The renderer's main-world systems, in `Update` after the light engine
+/// (`HeliodonSystems::Lighting`), in order:
+/// 1. `Surfaces`: the patch meshes spawned and their vertex values set from
+///    the light ([`surfaces`]);
+/// 2. `SunPass`: what the stencil pass draws, rebuilt when the scene, the sun
+///    or the mode change ([`sun_pass`]);
+/// 3. `Exposure`: automatic exposure and the tone map of the mode.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum HeliodonRenderSystems {
+    Surfaces,
+    SunPass,
+    Exposure,
+}
+
 /// What shows where there is no model: a pale sky.
 pub const BACKGROUND: Color = Color::srgb(0.82, 0.86, 0.9);
 
@@ -36,8 +49,15 @@ impl Plugin for HeliodonRenderPlugin {
     fn build(&self, app: &mut App) {
         app.insert_resource(ClearColor(BACKGROUND))
             .init_resource::<RenderSettings>()
+            .configure_sets(
+                Update,
+                (HeliodonRenderSystems::Surfaces, HeliodonRenderSystems::SunPass, HeliodonRenderSystems::Exposure)
+                    .chain()
+                    .after(HeliodonSystems::Lighting),
+            )
             .add_plugins((SurfaceLightingPlugin, SunPassPlugin))
-            .add_systems(Update, (update_sun_pass, auto_exposure, tone_mapping_for_mode).after(HeliodonSystems::Lighting));
+            .add_systems(Update, update_sun_pass.in_set(HeliodonRenderSystems::SunPass))
+            .add_systems(Update, (auto_exposure, tone_mapping_for_mode).in_set(HeliodonRenderSystems::Exposure));
     }
 }
 
@@ -101,10 +121,7 @@ pub fn hybrid_camera() -> impl Bundle {
 }
 
 /// False colour is shown as computed; every other mode is tone-mapped.
-fn tone_mapping_for_mode(
-    settings: Res<RenderSettings>,
-    mut cameras: Query<(Ref<SunPassView>, &mut Tonemapping), Without<PhysicalUnits>>,
-) {
+fn tone_mapping_for_mode(settings: Res<RenderSettings>, mut cameras: Query<(Ref<SunPassView>, &mut Tonemapping), Without<PhysicalUnits>>) {
     let wanted = if settings.mode == RenderMode::FalseColour { Tonemapping::None } else { FILMIC };
     for (view, mut tonemapping) in &mut cameras {
         if (settings.is_changed() || view.is_added()) && *tonemapping != wanted {
@@ -119,7 +136,8 @@ const FILMIC: Tonemapping = Tonemapping::AgX;
 /// The false-colour scale (shaders/lighting.wgsl draws the same): linear
 /// RGB for an illuminance, logarithmic over the three decades below `top`.
 pub fn false_colour(lux: f32, top: f32) -> [f32; 3] {
-    const STOPS: [[f32; 3]; 6] = [[0.02, 0.02, 0.35], [0.0, 0.45, 0.9], [0.05, 0.75, 0.25], [0.95, 0.9, 0.1], [0.9, 0.15, 0.05], [1.0, 1.0, 1.0]];
+    const STOPS: [[f32; 3]; 6] =
+        [[0.02, 0.02, 0.35], [0.0, 0.45, 0.9], [0.05, 0.75, 0.25], [0.95, 0.9, 0.1], [0.9, 0.15, 0.05], [1.0, 1.0, 1.0]];
     let t = ((lux.max(1e-6) / top).log2() / 1000f32.log2() + 1.0).clamp(0.0, 1.0);
     let x = t * 5.0;
     let i = (x.floor() as usize).min(4);
@@ -233,7 +251,13 @@ const METERED_PATCHES: usize = 4096;
 
 /// Log-average luminance (cd/m²) of the diffuse patch sides a camera sees
 /// (facing it, inside its view cone, not hidden), weighted by solid angle.
-fn metered_luminance(scene: &Scene, model: &LightModel, sides: &[Channels], camera: &GlobalTransform, projection: &Projection) -> Option<f64> {
+fn metered_luminance(
+    scene: &Scene,
+    model: &LightModel,
+    sides: &[Channels],
+    camera: &GlobalTransform,
+    projection: &Projection,
+) -> Option<f64> {
     let eye = camera.translation().as_dvec3();
     let forward = camera.forward().as_vec3().as_dvec3();
     let Projection::Perspective(perspective) = projection else { return None };
@@ -277,12 +301,7 @@ pub fn initial_view(scene: &Scene) -> Viewpoint {
     }
     let fov = DEFAULT_FOV;
     let (target, distance) = framing(scene.bounds, fov);
-    Viewpoint {
-        name: "overview".into(),
-        eye: target + Vec3::new(-0.55, -0.75, 0.55).normalize() * distance,
-        target,
-        fov,
-    }
+    Viewpoint { name: "overview".into(), eye: target + Vec3::new(-0.55, -0.75, 0.55).normalize() * distance, target, fov }
 }
 
 /// Centre of the bounds and the distance at which a camera with this vertical

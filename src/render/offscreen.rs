@@ -24,8 +24,8 @@ use bevy::winit::WinitPlugin;
 use super::sun_pass::SunPassInput;
 use super::{HeliodonRenderPlugin, PhysicalUnits, RenderMode, RenderSettings, hybrid_camera, initial_view};
 use crate::ecs::{
-    ActiveScene, HeliodonPlugins, LightingFailed, LightingPlugin, LightingState, OpenScene, SceneLoadFailed, SceneSpawned, SkyChoice,
-    SolarTime, SunSky,
+    ActiveScene, HeliodonPlugins, LightingFailed, LightingPlugin, LightingState, OpenScene, RegisterPanel, SceneLoadFailed, SceneSpawned,
+    SkyChoice, SolarTime, SunSky,
 };
 use crate::scene::Viewpoint;
 use crate::sky::{LUMINOUS_EFFICACY, SkySpec};
@@ -44,8 +44,8 @@ pub struct OffscreenRequest {
     /// `None`: the app's default sky.
     pub sky: Option<SkySpec>,
     pub settings: RenderSettings,
-    /// Adds the panel plugins the scene may name.
-    pub add_panels: crate::ecs::AddPanels,
+    /// The panel types the scene may name.
+    pub panels: crate::panel::PanelCatalog,
 }
 
 /// One rendered frame.
@@ -61,8 +61,8 @@ pub struct RenderedImage {
 
 impl RenderedImage {
     pub fn save_png(&self, path: &Path) -> Result<(), String> {
-        let buffer = image::RgbaImage::from_raw(self.width, self.height, self.rgba.clone())
-            .ok_or("image size does not match its pixels")?;
+        let buffer =
+            image::RgbaImage::from_raw(self.width, self.height, self.rgba.clone()).ok_or("image size does not match its pixels")?;
         buffer.save(path).map_err(|e| format!("{}: cannot write image: {e}", path.display()))
     }
 
@@ -74,27 +74,17 @@ impl RenderedImage {
     }
 }
 
-/// Writes luminance pixels (cd/m², row-major) as a Radiance picture (RGBE)
-/// in W/sr/m² per channel (179 lm/W), as Radiance's tools expect.
+/// Writes luminance pixels (cd/m², row-major) as a Radiance picture (RGBE,
+/// run-length encoded by `image`'s HDR encoder) in W/sr/m² per channel
+/// (179 lm/W), as Radiance's tools expect.
 pub fn save_hdr(path: &Path, width: u32, height: u32, physical: &[[f32; 3]]) -> Result<(), String> {
-    let mut out = Vec::with_capacity(physical.len() * 4 + 128);
-    let _ = write!(out, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\nEXPOSURE=1\nSOFTWARE=heliodon\n\n-Y {height} +X {width}\n");
-    for pixel in physical {
-        out.extend(rgbe(pixel.map(|c| c / LUMINOUS_EFFICACY as f32)));
-    }
-    std::fs::write(path, out).map_err(|e| format!("{}: cannot write image: {e}", path.display()))
-}
-
-/// Radiance's shared-exponent encoding of one pixel.
-fn rgbe(rgb: [f32; 3]) -> [u8; 4] {
-    let max = rgb.iter().copied().fold(0.0f32, f32::max);
-    if max.is_nan() || max <= 1e-32 {
-        return [0; 4];
-    }
-    let exponent = max.log2().floor() as i32 + 1;
-    let scale = 256.0 / 2f32.powi(exponent);
-    let [r, g, b] = rgb.map(|c| (c.max(0.0) * scale).min(255.0) as u8);
-    [r, g, b, (exponent + 128) as u8]
+    let radiance: Vec<image::Rgb<f32>> =
+        physical.iter().map(|p| image::Rgb(p.map(|c| if c.is_finite() { c.max(0.0) / LUMINOUS_EFFICACY as f32 } else { 0.0 }))).collect();
+    let fail = |e: &dyn std::fmt::Display| format!("{}: cannot write image: {e}", path.display());
+    let file = std::fs::File::create(path).map_err(|e| fail(&e))?;
+    let mut writer = std::io::BufWriter::new(file);
+    image::codecs::hdr::HdrEncoder::new(&mut writer).encode(&radiance, width as usize, height as usize).map_err(|e| fail(&e))?;
+    writer.flush().map_err(|e| fail(&e))
 }
 
 /// Frames to draw once the light is ready before capturing: pipelines
@@ -137,7 +127,7 @@ pub fn offscreen_app(request: &OffscreenRequest) -> App {
     } else {
         app.add_plugins(HeliodonPlugins);
     }
-    (request.add_panels)(&mut app);
+    app.register_panels(&request.panels);
     app.add_plugins(HeliodonRenderPlugin)
         .insert_resource(request.settings)
         .insert_resource(Job {
@@ -149,15 +139,18 @@ pub fn offscreen_app(request: &OffscreenRequest) -> App {
             physical: Arc::default(),
             failure: None,
         })
-        .add_systems(Startup, |job: Res<Job>, mut open: MessageWriter<OpenScene>, mut time: ResMut<SolarTime>, mut sky: ResMut<SkyChoice>| {
-            open.write(OpenScene(job.request.scene.clone()));
-            if let Some(when) = job.request.when {
-                time.0 = when;
-            }
-            if let Some(spec) = job.request.sky.clone() {
-                sky.0 = spec;
-            }
-        })
+        .add_systems(
+            Startup,
+            |job: Res<Job>, mut open: MessageWriter<OpenScene>, mut time: ResMut<SolarTime>, mut sky: ResMut<SkyChoice>| {
+                open.write(OpenScene(job.request.scene.clone()));
+                if let Some(when) = job.request.when {
+                    time.0 = when;
+                }
+                if let Some(spec) = job.request.sky.clone() {
+                    sky.0 = spec;
+                }
+            },
+        )
         .add_systems(Update, (spawn_cameras, count_ready_frames).chain().after(crate::ecs::HeliodonSystems::SpawnScene));
     app
 }
@@ -235,12 +228,19 @@ fn spawn_cameras(
 /// direct sun alone, the sun pass's frame.
 fn light_ready(mode: RenderMode, lighting: Option<&LightingState>, sun_pass: &SunPassInput, sun_sky: Option<&SunSky>) -> bool {
     match mode {
-        RenderMode::Sun => sun_sky.is_some() && (sun_pass.0.is_some() || sun_sky.is_some_and(|s| s.sky.sun.is_none_or(|sun| sun.direction.z <= 0.0))),
+        RenderMode::Sun => {
+            sun_sky.is_some() && (sun_pass.0.is_some() || sun_sky.is_some_and(|s| s.sky.sun.is_none_or(|sun| sun.direction.z <= 0.0)))
+        }
         _ => lighting.is_some_and(|l| l.converged),
     }
 }
 
-fn count_ready_frames(mut job: ResMut<Job>, lighting: Option<Res<LightingState>>, sun_pass: Res<SunPassInput>, sun_sky: Option<Res<SunSky>>) {
+fn count_ready_frames(
+    mut job: ResMut<Job>,
+    lighting: Option<Res<LightingState>>,
+    sun_pass: Res<SunPassInput>,
+    sun_sky: Option<Res<SunSky>>,
+) {
     if job.targets.is_some() && light_ready(job.request.settings.mode, lighting.as_deref(), &sun_pass, sun_sky.as_deref()) {
         job.frames_drawn += 1;
     } else {
@@ -278,7 +278,8 @@ pub fn float_pixels(image: &Image) -> Vec<[f32; 3]> {
 }
 
 fn finish(job: Res<Job>, mut exit: MessageWriter<AppExit>) {
-    let done = job.picture.lock().expect("offscreen picture lock").is_some() && job.physical.lock().expect("offscreen physical lock").is_some();
+    let done =
+        job.picture.lock().expect("offscreen picture lock").is_some() && job.physical.lock().expect("offscreen physical lock").is_some();
     if done || job.failure.is_some() {
         exit.write(AppExit::Success);
     }

@@ -9,9 +9,8 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use super::offscreen::{self, OffscreenRequest};
 use super::RenderMode;
-use crate::ecs::panel_catalog;
+use super::offscreen::{self, OffscreenRequest};
 use crate::light::LightModel;
 use crate::scene::{MaterialKind, Viewpoint, load_scene};
 use crate::sky::{LUMINOUS_EFFICACY, sky_at};
@@ -69,7 +68,7 @@ impl std::fmt::Display for SunComparison {
 /// picture is).
 pub fn compare_direct_sun(request: &OffscreenRequest, picture: &Path) -> Result<SunComparison, String> {
     let request = OffscreenRequest { settings: super::RenderSettings { mode: RenderMode::Sun, ..request.settings }, ..request.clone() };
-    let scene = Arc::new(load_scene(&request.scene, &panel_catalog(request.add_panels)).map_err(|e| e.to_string())?.scene);
+    let scene = Arc::new(load_scene(&request.scene, &request.panels).map_err(|e| e.to_string())?.scene);
     let model = LightModel::unlit(scene.clone());
     let when = request.when.ok_or("the comparison needs a time")?;
     let spec = request.sky.clone().ok_or("the comparison needs a sky")?;

@@ -17,8 +17,8 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{AsBindGroup, ShaderType};
 use bevy::shader::ShaderRef;
 
-use super::{RenderMode, RenderSettings};
-use crate::ecs::{ActiveScene, HeliodonSystems, LightingState, SceneSpawned};
+use super::{HeliodonRenderSystems, RenderMode, RenderSettings};
+use crate::ecs::{ActiveScene, LightingState, SceneSpawned};
 use crate::light::{Channels, side_of};
 use crate::scene::{MaterialKind, Scene};
 use crate::sky::LUMINOUS_EFFICACY;
@@ -28,11 +28,10 @@ pub struct SurfaceLightingPlugin;
 impl Plugin for SurfaceLightingPlugin {
     fn build(&self, app: &mut App) {
         let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
-        let _ = shaders.insert(LIGHTING_SHADER.id(), Shader::from_wgsl(include_str!("../../shaders/lighting.wgsl"), "shaders/lighting.wgsl"));
-        app.add_plugins(MaterialPlugin::<LightingMaterial>::default()).add_systems(
-            Update,
-            (spawn_surface_meshes, update_surface_values).chain().after(HeliodonSystems::Lighting),
-        );
+        let _ =
+            shaders.insert(LIGHTING_SHADER.id(), Shader::from_wgsl(include_str!("../../shaders/lighting.wgsl"), "shaders/lighting.wgsl"));
+        app.add_plugins(MaterialPlugin::<LightingMaterial>::default())
+            .add_systems(Update, (spawn_surface_meshes, update_surface_values).chain().in_set(HeliodonRenderSystems::Surfaces));
     }
 }
 
@@ -71,7 +70,10 @@ pub struct LightingMaterialUniform {
 }
 
 impl bevy::render::render_resource::AsBindGroupShaderType<LightingMaterialUniform> for LightingMaterial {
-    fn as_bind_group_shader_type(&self, _: &bevy::render::render_asset::RenderAssets<bevy::render::texture::GpuImage>) -> LightingMaterialUniform {
+    fn as_bind_group_shader_type(
+        &self,
+        _: &bevy::render::render_asset::RenderAssets<bevy::render::texture::GpuImage>,
+    ) -> LightingMaterialUniform {
         LightingMaterialUniform {
             tint: self.tint.to_vec4(),
             mode: u32::from(self.mode == RenderMode::FalseColour),
@@ -158,7 +160,8 @@ fn underlay_mesh(scene: &Scene, material: u32) -> (Mesh, SurfaceValues) {
     let mut builder = MeshBuilder::default();
     for surface in scene.surfaces.iter().filter(|s| s.material == material) {
         for back in [false, true] {
-            let sides: Vec<(u32, f32)> = (surface.patches.clone()).map(|p| (side_of(p, back), scene.patches.patches[p as usize].area)).collect();
+            let sides: Vec<(u32, f32)> =
+                (surface.patches.clone()).map(|p| (side_of(p, back), scene.patches.patches[p as usize].area)).collect();
             let node = builder.values.nodes.len() as u32;
             builder.values.nodes.push(sides);
             let normal = if back { -surface.normal } else { surface.normal };
@@ -231,18 +234,14 @@ fn material_mesh(scene: &Scene, material: u32) -> Option<(Mesh, SurfaceValues)> 
 /// What a patch side shows in a mode: luminance (cd/m², RGB) or, for false
 /// colour, illuminance (lux) in the first channel.
 pub fn side_value(channels: &Channels, reflectance: [f32; 3], mode: RenderMode) -> [f32; 3] {
-    let luminance = |irradiance: [f64; 3]| {
-        [0, 1, 2].map(|c| (f64::from(reflectance[c]) / PI * irradiance[c] * LUMINOUS_EFFICACY) as f32)
-    };
+    let luminance = |irradiance: [f64; 3]| [0, 1, 2].map(|c| (f64::from(reflectance[c]) / PI * irradiance[c] * LUMINOUS_EFFICACY) as f32);
     match mode {
         // The sun pass draws the sun's beams; panels' diffuse sunlight is drawn here.
         RenderMode::Full => luminance(channels.indirect.map(|i| i + channels.sky + channels.sun_diffuse)),
         RenderMode::Sun => [0.0; 3],
         RenderMode::Sky => luminance([channels.sky; 3]),
         RenderMode::Indirect => luminance(channels.indirect),
-        RenderMode::FalseColour => {
-            [((channels.sun + channels.sky + channels.indirect_luminous()) * LUMINOUS_EFFICACY) as f32, 0.0, 0.0]
-        }
+        RenderMode::FalseColour => [((channels.sun + channels.sky + channels.indirect_luminous()) * LUMINOUS_EFFICACY) as f32, 0.0, 0.0],
     }
 }
 
@@ -278,10 +277,14 @@ fn update_surface_values(
                 sum.map(|s| s / total.max(f32::MIN_POSITIVE))
             })
             .collect();
-        let colours: Vec<[f32; 4]> = values.vertex_node.iter().map(|&n| {
-            let [r, g, b] = node_values[n as usize];
-            [r, g, b, 1.0]
-        }).collect();
+        let colours: Vec<[f32; 4]> = values
+            .vertex_node
+            .iter()
+            .map(|&n| {
+                let [r, g, b] = node_values[n as usize];
+                [r, g, b, 1.0]
+            })
+            .collect();
         if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
             mesh.insert_attribute(Mesh::ATTRIBUTE_COLOR, colours);
         }

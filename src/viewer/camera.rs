@@ -3,15 +3,54 @@
 //! without a drag leaves the view alone), right- or middle-drag
 //! pans, the wheel zooms toward the point under the cursor, `F` frames the
 //! whole model. In walk mode (a panel checkbox) W/A/S/D move the eye at its
-//! height and left-drag looks around from it. z is up.
+//! height and left-drag looks around from it. z is up. The camera panel's
+//! presets and viewpoints arrive as [`CameraControl`] requests.
 
 use bevy::input::mouse::{AccumulatedMouseScroll, MouseScrollUnit};
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
+use super::ViewerSystems;
+use super::focus::PanelFocus;
 use crate::ecs::ActiveScene;
 use crate::render::framing;
 use crate::scene::Viewpoint;
+
+/// The camera: navigation every frame, and the requests of the camera panel.
+pub struct CameraPlugin;
+
+impl Plugin for CameraPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<CameraControl>().add_systems(Update, (apply_camera_request, navigate).chain().in_set(ViewerSystems::Camera));
+    }
+}
+
+/// What the camera panel asks of the camera, and the views kept this session.
+#[derive(Resource, Debug, Clone, Default)]
+pub struct CameraControl {
+    /// A change asked for, applied by [`apply_camera_request`].
+    pub request: Option<CameraRequest>,
+    /// Views the user saved this session.
+    pub saved_views: Vec<Viewpoint>,
+    /// Walk mode: W/A/S/D move the eye at its height, dragging looks around.
+    pub walk: bool,
+}
+
+/// The camera changes the panel offers.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CameraRequest {
+    /// Straight down on the model.
+    Top,
+    /// From the south, level.
+    Front,
+    /// From the east, level.
+    Side,
+    /// From the south-west and above.
+    Perspective,
+    Viewpoint(Viewpoint),
+    /// Keep the current view in the list.
+    Save,
+}
 
 /// Orbit state; the transform is derived from it every frame.
 #[derive(Component, Debug, Clone, Copy)]
@@ -38,12 +77,7 @@ impl CadCamera {
     pub fn looking(eye: Vec3, target: Vec3) -> Self {
         let offset = eye - target;
         let distance = offset.length().max(1e-3);
-        Self {
-            focus: target,
-            distance,
-            yaw: offset.y.atan2(offset.x),
-            pitch: (offset.z / distance).clamp(-1.0, 1.0).asin(),
-        }
+        Self { focus: target, distance, yaw: offset.y.atan2(offset.x), pitch: (offset.z / distance).clamp(-1.0, 1.0).asin() }
     }
 
     pub fn from_viewpoint(view: &Viewpoint) -> Self {
@@ -81,7 +115,8 @@ pub fn navigate(
     scroll: Res<AccumulatedMouseScroll>,
     window: Single<&Window, With<PrimaryWindow>>,
     active: Res<ActiveScene>,
-    ui: Option<Res<super::ui::UiState>>,
+    focus: Option<Res<PanelFocus>>,
+    control: Option<Res<CameraControl>>,
     ray_model: Option<Res<crate::render::RayModel>>,
     time: Res<Time>,
     mut cameras: Query<(&mut CadCamera, &mut Transform, &Camera, &GlobalTransform, &Projection)>,
@@ -93,10 +128,10 @@ pub fn navigate(
     // there on every system: remote desktops, Xvfb).
     let moved = window.cursor_position().zip(*last_cursor).map_or(Vec2::ZERO, |(now, before)| now - before);
     *last_cursor = window.cursor_position();
-    let over_panels = ui.as_ref().zip(window.cursor_position()).is_some_and(|(ui, cursor)| ui.over_panels(cursor));
-    let walking = ui.as_ref().is_some_and(|ui| ui.walk);
+    let over_panels = focus.as_ref().zip(window.cursor_position()).is_some_and(|(focus, cursor)| focus.over_panels(cursor));
+    let walking = control.as_ref().is_some_and(|c| c.walk);
     // Keys typed into a panel field are for the field.
-    let keys_for_camera = !ui.as_ref().is_some_and(|ui| ui.keyboard_for_panels);
+    let keys_for_camera = !focus.as_ref().is_some_and(|f| f.keyboard);
     let buttons = [MouseButton::Left, MouseButton::Right, MouseButton::Middle];
     for (mut cad, mut transform, camera, global, projection) in &mut cameras {
         let fov = match projection {
@@ -179,6 +214,32 @@ pub fn navigate(
             cad.distance = distance;
         }
         *transform = cad.transform();
+    }
+}
+
+/// Applies the camera panel's request.
+pub fn apply_camera_request(mut control: ResMut<CameraControl>, active: Res<ActiveScene>, mut cameras: Query<&mut CadCamera>) {
+    let Some(request) = control.request.take() else { return };
+    let Some(scene) = &active.scene else { return };
+    let (centre, distance) = framing(scene.bounds, crate::scene::DEFAULT_FOV);
+    for mut camera in &mut cameras {
+        let (yaw, pitch) = match &request {
+            CameraRequest::Top => (-std::f32::consts::FRAC_PI_2, 1.5),
+            CameraRequest::Front => (-std::f32::consts::FRAC_PI_2, 0.0),
+            CameraRequest::Side => (0.0, 0.0),
+            CameraRequest::Perspective => (-2.2, 0.6),
+            CameraRequest::Viewpoint(view) => {
+                *camera = CadCamera::from_viewpoint(view);
+                continue;
+            }
+            CameraRequest::Save => {
+                let name = format!("saved {}", control.saved_views.len() + 1);
+                let eye = camera.eye();
+                control.saved_views.push(Viewpoint { name, eye, target: camera.focus, fov: crate::scene::DEFAULT_FOV });
+                continue;
+            }
+        };
+        *camera = CadCamera { focus: centre, distance, yaw, pitch };
     }
 }
 

@@ -5,8 +5,19 @@
 
 use bevy::prelude::*;
 
+use super::ViewerSystems;
+use super::focus::PanelFocus;
 use crate::ecs::{ActiveScene, SunSky};
 use crate::render::RayModel;
+
+/// `L` and the lobe arrows.
+pub struct LobesPlugin;
+
+impl Plugin for LobesPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<ShownLobes>().add_systems(Update, (select_panel_window, draw_lobes).chain().in_set(ViewerSystems::Overlays));
+    }
+}
 
 /// The panel window whose lobes are shown ([`crate::scene::Scene::windows`] index).
 #[derive(Resource, Debug, Default, Clone, Copy, PartialEq, Eq)]
@@ -17,13 +28,13 @@ const ARROW_LENGTH: f32 = 1.5;
 
 pub fn select_panel_window(
     keys: Res<ButtonInput<KeyCode>>,
-    ui: Option<Res<super::ui::UiState>>,
+    focus: Option<Res<PanelFocus>>,
     active: Res<ActiveScene>,
     ray_model: Option<Res<RayModel>>,
     mut shown: ResMut<ShownLobes>,
 ) {
     // An L typed into a panel field is for the field.
-    if !keys.just_pressed(KeyCode::KeyL) || ui.is_some_and(|ui| ui.keyboard_for_panels) {
+    if !keys.just_pressed(KeyCode::KeyL) || focus.is_some_and(|f| f.keyboard) {
         return;
     }
     let (Some(scene), Some(model)) = (&active.scene, ray_model) else { return };
@@ -35,7 +46,13 @@ pub fn select_panel_window(
     };
 }
 
-pub fn draw_lobes(mut gizmos: Gizmos, shown: Res<ShownLobes>, active: Res<ActiveScene>, ray_model: Option<Res<RayModel>>, sun_sky: Option<Res<SunSky>>) {
+pub fn draw_lobes(
+    mut gizmos: Gizmos,
+    shown: Res<ShownLobes>,
+    active: Res<ActiveScene>,
+    ray_model: Option<Res<RayModel>>,
+    sun_sky: Option<Res<SunSky>>,
+) {
     let (Some(window), Some(scene), Some(model), Some(sun_sky)) = (shown.0, &active.scene, ray_model, sun_sky) else { return };
     let Some(window) = scene.windows.get(window) else { return };
     let Some(sun) = sun_sky.sky.sun.filter(|s| s.direction.z > 0.0) else { return };

@@ -11,17 +11,32 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task, block_on, futures_lite::future};
 
+use super::ViewerSystems;
+use super::camera::cursor_in_view;
+use super::focus::PanelFocus;
+pub use crate::day::{DAY_STEPS, YEAR_DAYS};
+use crate::day::{day_series, year_map_dates};
 use crate::ecs::{LightEngine, LightingState, Site, SkyChoice, SolarTime};
 use crate::light::LightModel;
-use crate::sky::{SkySpec, sky_at};
-use crate::time::{Date, LocalDateTime, TimeOfDay};
+use crate::time::Date;
+
+/// Sensors in the viewer: selection, markers, and the selected sensor's day
+/// and year computed in the background.
+pub struct SensorsPlugin;
+
+impl Plugin for SensorsPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<SelectedSensor>()
+            .init_resource::<DaySeries>()
+            .init_resource::<YearMap>()
+            .add_systems(Update, (pick_sensor, update_day_series, update_year_map).in_set(ViewerSystems::Sensors))
+            .add_systems(bevy_egui::EguiPrimaryContextPass, draw_markers.in_set(ViewerSystems::Overlays));
+    }
+}
 
 /// The sensor the panels and the plot follow.
 #[derive(Resource, Debug, Default, Clone, Copy, PartialEq, Eq)]
 pub struct SelectedSensor(pub Option<usize>);
-
-/// Half-hour steps of the day plot.
-pub const DAY_STEPS: usize = 48;
 
 /// A result computed in the background for a key (what it was asked for).
 pub struct Background<K, T> {
@@ -62,9 +77,6 @@ impl<K: PartialEq, T: Send + 'static> Background<K, T> {
 /// key restarts it).
 #[derive(Resource, Default)]
 pub struct DaySeries(pub Background<(usize, Date, String), Vec<f64>>);
-
-/// Days of the year map: every two weeks from 1 January.
-pub const YEAR_DAYS: usize = 26;
 
 /// The selected sensor's illuminance over the year: day × half hour (the
 /// thesis' figure 1.4h), computed in the background when asked for.
@@ -130,9 +142,8 @@ pub fn update_year_map(inputs: PlotInputs, mut year: ResMut<YearMap>) {
     let done = Arc::new(AtomicUsize::new(0));
     year.done = done.clone();
     year.map.start(key, move || {
-        (0..YEAR_DAYS)
-            .map(|k| {
-                let date = Date::new(first, 1, 1).expect("1 January").add_days(14 * k as i64);
+        year_map_dates(first)
+            .map(|date| {
                 let day = day_series(&model, sensor, &site, date, &spec);
                 done.fetch_add(1, Ordering::Relaxed);
                 day
@@ -170,7 +181,11 @@ pub fn draw_markers(
                 .fixed_pos(bevy_egui::egui::pos2(screen.x + 6.0, screen.y - 18.0))
                 .interactable(false)
                 .show(&ctx, |ui| {
-                    ui.label(bevy_egui::egui::RichText::new(format!("{} {:.0} lx", sensor.name, reading.total)).small().background_color(bevy_egui::egui::Color32::from_black_alpha(160)));
+                    ui.label(
+                        bevy_egui::egui::RichText::new(format!("{} {:.0} lx", sensor.name, reading.total))
+                            .small()
+                            .background_color(bevy_egui::egui::Color32::from_black_alpha(160)),
+                    );
                 });
         }
     }
@@ -182,14 +197,14 @@ pub fn pick_sensor(
     mouse: Res<ButtonInput<MouseButton>>,
     window: Single<&Window, bevy::ecs::query::With<bevy::window::PrimaryWindow>>,
     active: Res<crate::ecs::ActiveScene>,
-    ui: Res<super::ui::UiState>,
+    focus: Res<PanelFocus>,
     camera: Query<(&Camera, &GlobalTransform), crate::render::PictureCamera>,
     mut pressed_at: Local<Option<Vec2>>,
     mut selected: ResMut<SelectedSensor>,
 ) {
     let (Some(scene), Ok((camera, transform))) = (&active.scene, camera.single()) else { return };
     // A click in the view, off the panels, that does not move.
-    let cursor = window.cursor_position().filter(|c| !ui.over_panels(*c)).and_then(|_| super::camera::cursor_in_view(&window, camera));
+    let cursor = window.cursor_position().filter(|c| !focus.over_panels(*c)).and_then(|_| cursor_in_view(&window, camera));
     if mouse.just_pressed(MouseButton::Left) {
         *pressed_at = cursor;
     }
@@ -224,19 +239,4 @@ pub fn update_day_series(inputs: PlotInputs, mut series: ResMut<DaySeries>) {
     }
     let spec = inputs.sky.0.clone();
     series.0.start(Some(key), move || day_series(&model, sensor, &site, date, &spec));
-}
-
-/// A sensor's total lux every half hour of a day.
-pub fn day_series(model: &Arc<LightModel>, sensor: usize, site: &crate::site::Site, date: Date, spec: &SkySpec) -> Vec<f64> {
-    let mut previous = None;
-    (0..DAY_STEPS)
-        .map(|k| {
-            let time = TimeOfDay::from_hours((k as f64 + 0.5) * 24.0 / DAY_STEPS as f64).expect("a time of day");
-            let Ok(sky) = sky_at(site, spec, &LocalDateTime { date, time }).1 else { return 0.0 };
-            let lighting = model.solve(&sky, previous.as_ref());
-            let value = lighting.sensors.get(sensor).map_or(0.0, |r| r.total);
-            previous = Some(lighting);
-            value
-        })
-        .collect()
 }

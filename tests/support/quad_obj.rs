@@ -13,10 +13,7 @@ pub struct QuadObj {
 impl QuadObj {
     /// An empty model whose materials come from the MTL file `mtl`.
     pub fn new(mtl: &str) -> Self {
-        Self {
-            text: format!("mtllib {mtl}\n"),
-            vertices: 0,
-        }
+        Self { text: format!("mtllib {mtl}\n"), vertices: 0 }
     }
 
     /// Adds a quad of `material`; the order of its corners gives its normal.

@@ -22,22 +22,11 @@ pub mod xml;
 
 use std::sync::Arc;
 
-use heliodon::bevy::prelude::{App, Plugin};
-use heliodon::ecs::RegisterPanel;
-use heliodon::glam::DVec3;
-use heliodon::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters};
+use heliodon_core::glam::DVec3;
+use heliodon_core::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters};
 use spade::{DelaunayTriangulation, FloatTriangulation, Point2, Triangulation};
 
 use xml::{Basis, BsdfFile};
-
-/// Registers the `bsdf` panel.
-pub struct BsdfPlugin;
-
-impl Plugin for BsdfPlugin {
-    fn build(&self, app: &mut App) {
-        app.register_panel(Bsdf);
-    }
-}
 
 const FILE: Key = Key::file("file", "WINDOW6 BSDF XML (Klems basis)", "xml");
 const LOBES: Key = Key::count("lobes", "specular lobes fitted per direction", (1, 8), 3);
@@ -59,7 +48,8 @@ impl PanelType for Bsdf {
         let path = parameters.path(&FILE)?;
         let lobes = parameters.count(&LOBES)? as usize;
         let width = parameters.number(&LOBE_WIDTH)?;
-        let text = std::fs::read_to_string(&path).map_err(|e| ParameterError::new(FILE.name, format!("cannot read {}: {e}", path.display())))?;
+        let text =
+            std::fs::read_to_string(&path).map_err(|e| ParameterError::new(FILE.name, format!("cannot read {}: {e}", path.display())))?;
         let file = xml::parse(&text, &path).map_err(|e| ParameterError::new(FILE.name, e))?;
         Ok(Arc::new(BsdfModel::fit(&file, lobes, width)))
     }
@@ -68,7 +58,7 @@ impl PanelType for Bsdf {
 /// The centre directions of a Klems basis's patches and their projected
 /// solid angles π(cos²θlo − cos²θhi)/nφ.
 pub fn klems_patches(basis: &Basis) -> Vec<(DVec3, f64)> {
-    let mut out = Vec::with_capacity(basis.len());
+    let mut out = Vec::with_capacity(basis.patch_count());
     for ring in &basis.rings {
         let (lo, hi) = (ring.theta_low.to_radians(), ring.theta_high.to_radians());
         let theta = if ring.phis == 1 { 0.0 } else { 0.5 * (lo + hi) };
@@ -298,7 +288,8 @@ mod tests {
             projected.extend(std::iter::repeat_n(std::f64::consts::PI * (l.cos().powi(2) - h.cos().powi(2)) / phis as f64, phis));
         }
         let n = projected.len();
-        let values: Vec<String> = (0..n * n).map(|k| if k / n == k % n { format!("{}", 0.8 / projected[k % n]) } else { "0".into() }).collect();
+        let values: Vec<String> =
+            (0..n * n).map(|k| if k / n == k % n { format!("{}", 0.8 / projected[k % n]) } else { "0".into() }).collect();
         format!(
             "<?xml version=\"1.0\"?>\n<WindowElement><Optical><Layer><DataDefinition><IncidentDataStructure>Columns</IncidentDataStructure>\n<AngleBasis><AngleBasisName>LBNL/Klems Quarter</AngleBasisName>\n{blocks}</AngleBasis></DataDefinition>\n<WavelengthData><Wavelength unit=\"Integral\">Visible</Wavelength><WavelengthDataBlock><WavelengthDataDirection>Transmission Front</WavelengthDataDirection><ColumnAngleBasis>LBNL/Klems Quarter</ColumnAngleBasis><RowAngleBasis>LBNL/Klems Quarter</RowAngleBasis><ScatteringDataType>BTDF</ScatteringDataType><ScatteringData>{}</ScatteringData></WavelengthDataBlock></WavelengthData>\n</Layer></Optical></WindowElement>\n",
             values.join(",")
@@ -308,7 +299,7 @@ mod tests {
     #[test]
     fn a_quarter_basis_file_reads_and_fits() {
         let file = xml::parse(&quarter_basis_glass(), Path::new("quarter.xml")).unwrap();
-        assert_eq!(file.basis.len(), 41);
+        assert_eq!(file.basis.patch_count(), 41);
         let model = BsdfModel::fit(&file, 3, 23.0);
         assert!((model.captured - 1.0).abs() < 1e-9, "{}", model.captured);
         // At a measured direction, one lobe straight through with 0.8 of the light.
@@ -334,13 +325,20 @@ mod tests {
         let nan = format!("{}NaN,{}", &text[..data_start], &text[first_value_end..]);
         let error = xml::parse(&nan, path).unwrap_err();
         assert!(error.contains("'NaN' is not a finite number"), "{error}");
+        // An absurd basis is refused before anything is allocated for it.
+        let huge = text.replacen("<nPhis>1</nPhis>", "<nPhis>1000000000</nPhis>", 1);
+        assert!(xml::parse(&huge, path).unwrap_err().contains("bad angle basis block (nPhis 1000000000"));
+        // genBSDF's "Recover using" line before the declaration is skipped, and lines still count from the file's start.
+        let error = xml::parse(&format!("Recover using: genBSDF -recover x\n{nan}"), path).unwrap_err();
+        let nan_line = nan[..data_start].lines().count();
+        assert!(error.starts_with(&format!("bad.xml:{}:", nan_line + 1)), "{error}");
         let tree = text.replace("LBNL/Klems Full", "LBNL/Shirley-Chiu");
         assert!(xml::parse(&tree, path).unwrap_err().contains("tensor trees are not supported yet"));
     }
 
     #[test]
     fn keys_are_checked() {
-        assert_eq!(heliodon::panel::check_keys(Bsdf.keys()), Ok(()));
+        assert_eq!(heliodon_core::panel::check_keys(Bsdf.keys()), Ok(()));
         let folder = sample("clear.xml").parent().unwrap().to_path_buf();
         let build = |text: &str| Bsdf.build(&Parameters::from_toml(text, folder.clone()).unwrap());
         assert!(build("file = \"clear.xml\"").is_ok());

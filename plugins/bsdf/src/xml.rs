@@ -1,7 +1,10 @@
-//! Reading LBNL BSDF XML (WINDOW6 format) with Klems angle bases: just the
-//! elements heliodon needs, with errors that name the file and line.
+//! Reading LBNL BSDF XML (WINDOW6 format) with Klems angle bases through
+//! roxmltree: the elements heliodon needs, matched by local name (files
+//! carry WINDOW's namespace), with errors that name the file and line.
 
 use std::path::Path;
+
+use roxmltree::Node;
 
 /// One ring of a Klems basis: its polar bounds (degrees) and φ divisions.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -19,7 +22,7 @@ pub struct Basis {
 }
 
 impl Basis {
-    pub fn len(&self) -> usize {
+    pub fn patch_count(&self) -> usize {
         self.rings.iter().map(|r| r.phis).sum()
     }
 }
@@ -49,124 +52,134 @@ pub struct BsdfFile {
     pub wavelength: String,
 }
 
-/// Line number (from 1) of a byte offset.
-fn line_of(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
+/// Klems bases have 145 patches at most (the full basis); this leaves room
+/// for finer custom bases while refusing sizes that only a broken or hostile
+/// file declares (a matrix is n² values).
+const MAX_BASIS_PATCHES: usize = 2_000;
+
+/// The parsed document and its file's name, for errors.
+struct Reader<'a, 'i> {
+    doc: &'a roxmltree::Document<'i>,
+    file: &'a Path,
+    /// Lines before the XML declaration, to number lines as the file does.
+    skipped_lines: u32,
 }
 
-/// The elements named `tag` within `text[range]`: (start offset of the
-/// content, the content). A missing closing tag is an error (truncated file).
-fn elements<'a>(text: &'a str, range: (usize, usize), tag: &str, file: &Path) -> Result<Vec<(usize, &'a str)>, String> {
-    let (mut at, end) = range;
-    let open = format!("<{tag}");
-    let close = format!("</{tag}>");
-    let mut out = Vec::new();
-    while let Some(found) = text[at..end].find(&open) {
-        let start = at + found;
-        let after = start + open.len();
-        // `<Tag>` or `<Tag attr="...">`, not `<TagOther>`.
-        match text[after..end].chars().next() {
-            Some('>') | Some(' ') | Some('\t') | Some('\n') | Some('\r') | Some('/') => {}
-            _ => {
-                at = after;
-                continue;
-            }
-        }
-        let Some(gt) = text[after..end].find('>') else {
-            return Err(format!("{}:{}: <{tag}> is cut off (the file looks truncated)", file.display(), line_of(text, start)));
-        };
-        let content_start = after + gt + 1;
-        if text[after..after + gt].ends_with('/') {
-            out.push((content_start, ""));
-            at = content_start;
-            continue;
-        }
-        let Some(stop) = text[content_start..end].find(&close) else {
-            return Err(format!("{}:{}: <{tag}> has no </{tag}> (the file looks truncated)", file.display(), line_of(text, start)));
-        };
-        out.push((content_start, &text[content_start..content_start + stop]));
-        at = content_start + stop + close.len();
+impl<'a, 'i> Reader<'a, 'i> {
+    /// `file:line` of a node.
+    fn at(&self, node: Node) -> String {
+        format!("{}:{}", self.file.display(), self.line(node.range().start))
     }
-    Ok(out)
+
+    /// The file's line of a byte offset in the parsed text.
+    fn line(&self, offset: usize) -> u32 {
+        self.doc.text_pos_at(offset).row + self.skipped_lines
+    }
+
+    fn child(parent: Node<'a, 'i>, tag: &str) -> Option<Node<'a, 'i>> {
+        parent.children().find(|n| n.has_tag_name(tag))
+    }
+
+    fn required(&self, parent: Node<'a, 'i>, tag: &str) -> Result<Node<'a, 'i>, String> {
+        Self::child(parent, tag).ok_or_else(|| format!("{}: missing <{tag}>", self.at(parent)))
+    }
+
+    fn content(node: Node) -> String {
+        node.text().unwrap_or("").trim().to_string()
+    }
+
+    fn number(&self, node: Node, what: &str) -> Result<f64, String> {
+        let value = Self::content(node);
+        value
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("{}: {what} '{value}' is not a finite number", self.at(node)))
+    }
 }
 
-fn child<'a>(text: &'a str, parent: (usize, &'a str), tag: &str, file: &Path) -> Result<Option<(usize, &'a str)>, String> {
-    Ok(elements(text, (parent.0, parent.0 + parent.1.len()), tag, file)?.into_iter().next())
-}
-
-fn required<'a>(text: &'a str, parent: (usize, &'a str), tag: &str, file: &Path) -> Result<(usize, &'a str), String> {
-    child(text, parent, tag, file)?.ok_or_else(|| format!("{}:{}: missing <{tag}>", file.display(), line_of(text, parent.0)))
-}
-
-fn number(text: &str, (at, content): (usize, &str), what: &str, file: &Path) -> Result<f64, String> {
-    content
-        .trim()
-        .parse::<f64>()
-        .ok()
-        .filter(|v| v.is_finite())
-        .ok_or_else(|| format!("{}:{}: {what} '{}' is not a finite number", file.display(), line_of(text, at), content.trim()))
-}
-
-/// Reads a BSDF XML file's text.
+/// Reads a BSDF XML file's text (parsed by roxmltree; every error names
+/// the file and line).
 pub fn parse(text: &str, file: &Path) -> Result<BsdfFile, String> {
-    let whole = (0, text.len());
-    if !text.contains("</WindowElement>") {
-        return Err(format!("{}: no </WindowElement> at the end (the file looks truncated)", file.display()));
-    }
+    // genBSDF leaves a "Recover using: ..." line before the XML declaration
+    // in the files it writes; Radiance reads them, so heliodon does too.
+    let start = text.find('<').unwrap_or(0);
+    let (skipped_lines, text) = (text[..start].matches('\n').count() as u32, &text[start..]);
+    let doc = roxmltree::Document::parse(text).map_err(|e| {
+        let row = e.pos().row + skipped_lines;
+        let truncated = matches!(e, roxmltree::Error::UnclosedRootNode | roxmltree::Error::UnexpectedEndOfStream)
+            || e.pos().row as usize >= text.lines().count();
+        format!("{}:{row}: not well-formed XML: {e}{}", file.display(), if truncated { " (the file looks truncated)" } else { "" })
+    })?;
+    let r = Reader { doc: &doc, file, skipped_lines };
+    let root = doc.root_element();
     // The angle basis (tensor trees have none, or a non-Klems one).
-    let bases = elements(text, whole, "AngleBasis", file)?;
-    let Some(&basis_element) = bases.first() else {
+    let Some(basis_element) = root.descendants().find(|n| n.has_tag_name("AngleBasis")) else {
         return Err(format!("{}: no <AngleBasis>: tensor-tree BSDFs are not supported yet (use a Klems basis)", file.display()));
     };
-    let name = required(text, basis_element, "AngleBasisName", file)?.1.trim().to_string();
+    let name = Reader::content(r.required(basis_element, "AngleBasisName")?);
     if !name.contains("Klems") {
-        return Err(format!("{}:{}: angle basis '{name}' is not a Klems basis (tensor trees are not supported yet)", file.display(), line_of(text, basis_element.0)));
+        return Err(format!("{}: angle basis '{name}' is not a Klems basis (tensor trees are not supported yet)", r.at(basis_element)));
     }
     let mut rings = Vec::new();
-    for block in elements(text, (basis_element.0, basis_element.0 + basis_element.1.len()), "AngleBasisBlock", file)? {
-        let phis = number(text, required(text, block, "nPhis", file)?, "nPhis", file)?;
-        let bounds = required(text, block, "ThetaBounds", file)?;
-        let low = number(text, required(text, bounds, "LowerTheta", file)?, "LowerTheta", file)?;
-        let high = number(text, required(text, bounds, "UpperTheta", file)?, "UpperTheta", file)?;
-        if phis < 1.0 || phis.fract() != 0.0 || !(0.0..=90.0).contains(&low) || !(low..=90.0).contains(&high) {
-            return Err(format!("{}:{}: bad angle basis block (nPhis {phis}, theta {low}..{high})", file.display(), line_of(text, block.0)));
+    for block in basis_element.children().filter(|n| n.has_tag_name("AngleBasisBlock")) {
+        let phis = r.number(r.required(block, "nPhis")?, "nPhis")?;
+        let bounds = r.required(block, "ThetaBounds")?;
+        let low = r.number(r.required(bounds, "LowerTheta")?, "LowerTheta")?;
+        let high = r.number(r.required(bounds, "UpperTheta")?, "UpperTheta")?;
+        if phis < 1.0
+            || phis.fract() != 0.0
+            || phis > MAX_BASIS_PATCHES as f64
+            || !(0.0..=90.0).contains(&low)
+            || !(low..=90.0).contains(&high)
+        {
+            return Err(format!("{}: bad angle basis block (nPhis {phis}, theta {low}..{high})", r.at(block)));
         }
         rings.push(Ring { theta_low: low, theta_high: high, phis: phis as usize });
     }
     if rings.is_empty() {
-        return Err(format!("{}:{}: angle basis '{name}' has no blocks", file.display(), line_of(text, basis_element.0)));
+        return Err(format!("{}: angle basis '{name}' has no blocks", r.at(basis_element)));
     }
     let basis = Basis { name, rings };
-    let n = basis.len();
-    let rows_incident = elements(text, whole, "IncidentDataStructure", file)?.first().is_some_and(|e| e.1.trim() == "Rows");
+    let n = basis.patch_count();
+    if n > MAX_BASIS_PATCHES {
+        return Err(format!(
+            "{}: angle basis '{}' has {n} patches; at most {MAX_BASIS_PATCHES} are supported",
+            r.at(basis_element),
+            basis.name
+        ));
+    }
+    let rows_incident = root.descendants().find(|n| n.has_tag_name("IncidentDataStructure")).is_some_and(|e| Reader::content(e) == "Rows");
     // Scattering blocks by wavelength and direction.
     let mut blocks: Vec<(String, String, Matrix)> = Vec::new();
-    for data in elements(text, whole, "WavelengthData", file)? {
-        let wavelength = required(text, data, "Wavelength", file)?.1.trim().to_string();
-        for block in elements(text, (data.0, data.0 + data.1.len()), "WavelengthDataBlock", file)? {
-            let direction = required(text, block, "WavelengthDataDirection", file)?.1.trim().to_string();
-            if let Some(kind) = child(text, block, "ScatteringDataType", file)?
-                && !kind.1.trim().eq_ignore_ascii_case("BTDF")
-                && !kind.1.trim().eq_ignore_ascii_case("BRDF")
+    for data in root.descendants().filter(|n| n.has_tag_name("WavelengthData")) {
+        let wavelength = Reader::content(r.required(data, "Wavelength")?);
+        for block in data.children().filter(|n| n.has_tag_name("WavelengthDataBlock")) {
+            let direction = Reader::content(r.required(block, "WavelengthDataDirection")?);
+            if let Some(kind) = Reader::child(block, "ScatteringDataType")
+                && !Reader::content(kind).eq_ignore_ascii_case("BTDF")
+                && !Reader::content(kind).eq_ignore_ascii_case("BRDF")
             {
-                return Err(format!("{}:{}: scattering data type '{}' is not supported", file.display(), line_of(text, kind.0), kind.1.trim()));
+                return Err(format!("{}: scattering data type '{}' is not supported", r.at(kind), Reader::content(kind)));
             }
-            let data = required(text, block, "ScatteringData", file)?;
+            let data = r.required(block, "ScatteringData")?;
+            // The text node, to place a bad value on its own line.
+            let (values_text, values_start) =
+                data.first_child().map_or(("", data.range().start), |t| (t.text().unwrap_or(""), t.range().start));
             let mut values = Vec::with_capacity(n * n);
-            for token in data.1.split(|c: char| c.is_whitespace() || c == ',').filter(|t| !t.is_empty()) {
+            for token in values_text.split(|c: char| c.is_whitespace() || c == ',').filter(|t| !t.is_empty()) {
                 match token.parse::<f64>() {
                     Ok(v) if v.is_finite() => values.push(v.max(0.0)),
                     _ => {
-                        let offset = data.0 + data.1.find(token).unwrap_or(0);
-                        return Err(format!("{}:{}: scattering value '{token}' is not a finite number", file.display(), line_of(text, offset)));
+                        let offset = values_start + (token.as_ptr() as usize - values_text.as_ptr() as usize);
+                        return Err(format!("{}:{}: scattering value '{token}' is not a finite number", file.display(), r.line(offset)));
                     }
                 }
             }
             if values.len() != n * n {
                 return Err(format!(
-                    "{}:{}: {direction} ({wavelength}) has {} values; basis '{}' needs {n} × {n} = {}",
-                    file.display(),
-                    line_of(text, data.0),
+                    "{}: {direction} ({wavelength}) has {} values; basis '{}' needs {n} × {n} = {}",
+                    r.at(data),
                     values.len(),
                     basis.name,
                     n * n

@@ -15,19 +15,10 @@
 
 use std::sync::Arc;
 
-use heliodon::bevy::prelude::{App, Plugin};
-use heliodon::ecs::RegisterPanel;
-use heliodon::glam::DVec3;
-use heliodon::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters, fresnel_reflectance, reflect, refract};
-
-/// Registers the `laser_cut` panel.
-pub struct LaserCutPlugin;
-
-impl Plugin for LaserCutPlugin {
-    fn build(&self, app: &mut App) {
-        app.register_panel(LaserCut);
-    }
-}
+use heliodon_core::glam::DVec3;
+use heliodon_core::panel::{
+    Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters, fresnel_reflectance, reflect, refract,
+};
 
 /// The `laser_cut` panel type.
 pub struct LaserCut;
@@ -154,7 +145,8 @@ mod tests {
         let response = panel.response(from_above(60.0));
         let up: f64 = response.lobes.iter().filter(|l| l.direction.z > 0.0 && l.direction.y > 0.0).map(|l| l.share).sum();
         let down: f64 = response.lobes.iter().filter(|l| l.direction.z > 0.0 && l.direction.y < 0.0).map(|l| l.share).sum();
-        let faces = (1.0 - fresnel_reflectance(1.0, 1.49, 60f64.to_radians().cos())) * (1.0 - fresnel_reflectance(1.49, 1.0, inside.asin().cos()));
+        let faces =
+            (1.0 - fresnel_reflectance(1.0, 1.49, 60f64.to_radians().cos())) * (1.0 - fresnel_reflectance(1.49, 1.0, inside.asin().cos()));
         assert!((up - (2.0 - q) * faces).abs() < 0.01, "deflected up {up}");
         assert!((down - (q - 1.0) * faces).abs() < 0.01, "undeflected {down}");
         // The deflected lobe leaves mirrored: 60° up into the room.
@@ -183,10 +175,10 @@ mod tests {
 
     #[test]
     fn keys_are_checked() {
-        assert_eq!(heliodon::panel::check_keys(LaserCut.keys()), Ok(()));
+        assert_eq!(heliodon_core::panel::check_keys(LaserCut.keys()), Ok(()));
         let build = |text: &str| LaserCut.build(&Parameters::from_toml(text, "").unwrap());
         assert!(build("cut_spacing_ratio = 0.5").is_ok());
-        assert!(LaserCut.build(&Parameters::new(heliodon::panel::default_values(LaserCut.keys()), "")).is_ok());
+        assert!(LaserCut.build(&Parameters::new(heliodon_core::panel::default_values(LaserCut.keys()), "")).is_ok());
         assert_eq!(build("").unwrap_err().key, "cut_spacing_ratio");
         assert_eq!(build("cut_spacing_ratio = 0.5\ncut_angle = 80.0").unwrap_err().key, "cut_angle");
     }

@@ -12,23 +12,16 @@
 //! (default 1.49, acrylic).
 //!
 //! Written the way any panel plugin is: a [`PanelType`] that builds a
-//! [`PanelModel`] from the keys, registered by a Bevy plugin.
+//! [`PanelModel`] from the keys, on the core crate alone; an app registers
+//! it with one line (`app.register_panel(Prismatic)` in heliodon's ECS, or
+//! `PanelCatalog::with(Prismatic)`).
 
 use std::sync::Arc;
 
-use heliodon::bevy::prelude::{App, Plugin};
-use heliodon::ecs::RegisterPanel;
-use heliodon::glam::DVec3;
-use heliodon::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters, fresnel_reflectance, reflect, refract};
-
-/// Registers the `prismatic` panel.
-pub struct PrismaticPlugin;
-
-impl Plugin for PrismaticPlugin {
-    fn build(&self, app: &mut App) {
-        app.register_panel(Prismatic);
-    }
-}
+use heliodon_core::glam::DVec3;
+use heliodon_core::panel::{
+    Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters, fresnel_reflectance, reflect, refract,
+};
 
 /// The `prismatic` panel type.
 pub struct Prismatic;
@@ -53,7 +46,8 @@ impl PanelType for Prismatic {
 }
 
 const FACET_ANGLES: Key =
-    Key::numbers("facet_angles", "tilt from the panel plane of the upward and the downward facet (°)", (0.0, 89.0), &[40.0, 5.0]).required();
+    Key::numbers("facet_angles", "tilt from the panel plane of the upward and the downward facet (°)", (0.0, 89.0), &[40.0, 5.0])
+        .required();
 const REFRACTIVE_INDEX: Key = Key::number("refractive_index", "of the sheet (acrylic 1.49)", (1.0, 3.0), 1.49);
 
 /// Paths are followed through at most this many interactions; what is
@@ -237,10 +231,10 @@ mod tests {
 
     #[test]
     fn keys_are_checked() {
-        assert_eq!(heliodon::panel::check_keys(Prismatic.keys()), Ok(()));
+        assert_eq!(heliodon_core::panel::check_keys(Prismatic.keys()), Ok(()));
         let build = |text: &str| Prismatic.build(&Parameters::from_toml(text, "").unwrap());
         assert!(build("facet_angles = [40.0, 5.0]").is_ok());
-        assert!(Prismatic.build(&Parameters::new(heliodon::panel::default_values(Prismatic.keys()), "")).is_ok());
+        assert!(Prismatic.build(&Parameters::new(heliodon_core::panel::default_values(Prismatic.keys()), "")).is_ok());
         assert_eq!(build("").unwrap_err().key, "facet_angles");
         assert_eq!(build("facet_angles = [40.0, 95.0]").unwrap_err().key, "facet_angles");
         assert_eq!(build("facet_angles = [40.0, 5.0]\nrefractive_index = 0.5").unwrap_err().key, "refractive_index");

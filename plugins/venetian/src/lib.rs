@@ -14,19 +14,8 @@
 
 use std::sync::Arc;
 
-use heliodon::bevy::prelude::{App, Plugin};
-use heliodon::ecs::RegisterPanel;
-use heliodon::glam::DVec3;
-use heliodon::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters, reflect};
-
-/// Registers the `venetian` panel.
-pub struct VenetianPlugin;
-
-impl Plugin for VenetianPlugin {
-    fn build(&self, app: &mut App) {
-        app.register_panel(Venetian);
-    }
-}
+use heliodon_core::glam::DVec3;
+use heliodon_core::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters, reflect};
 
 /// The `venetian` panel type.
 pub struct Venetian;
@@ -92,7 +81,9 @@ impl VenetianModel {
         let half = self.width / 2.0;
         let depth = half * along.z.abs() + 1e-9;
         // The ray crosses the slat band |z| ≤ depth between these distances.
-        let (t0, t1) = if direction.z.abs() < 1e-12 { (0.0, f64::INFINITY) } else {
+        let (t0, t1) = if direction.z.abs() < 1e-12 {
+            (0.0, f64::INFINITY)
+        } else {
             let (a, b) = ((-depth - origin.z) / direction.z, (depth - origin.z) / direction.z);
             (a.min(b).max(0.0), a.max(b))
         };
@@ -137,11 +128,13 @@ impl PanelModel for VenetianModel {
         let (along, normal) = self.slat_axes();
         let start_z = -(self.width / 2.0) * along.z.abs() - 1e-6;
         let weight = 1.0 / RAYS as f64;
-        let add_lobe = |direction: DVec3, share: f64, response: &mut PanelResponse| {
-            match response.lobes.iter_mut().find(|l| l.direction.angle_between(direction) < 1e-6) {
-                Some(lobe) => lobe.share += share,
-                None => response.lobes.push(Lobe { direction, share, width: LOBE_WIDTH }),
-            }
+        let add_lobe = |direction: DVec3, share: f64, response: &mut PanelResponse| match response
+            .lobes
+            .iter_mut()
+            .find(|l| l.direction.angle_between(direction) < 1e-6)
+        {
+            Some(lobe) => lobe.share += share,
+            None => response.lobes.push(Lobe { direction, share, width: LOBE_WIDTH }),
         };
         for k in 0..RAYS {
             let mut origin = DVec3::new(0.0, (k as f64 + 0.5) / RAYS as f64 * self.spacing, start_z);
@@ -224,11 +217,11 @@ mod tests {
 
     #[test]
     fn keys_are_checked() {
-        assert_eq!(heliodon::panel::check_keys(Venetian.keys()), Ok(()));
+        assert_eq!(heliodon_core::panel::check_keys(Venetian.keys()), Ok(()));
         let build = |text: &str| Venetian.build(&Parameters::from_toml(text, "").unwrap());
         let ok = "slat_width = 0.025\nslat_spacing = 0.0225\ntilt = 30.0\nspecular = 0.9\ndiffuse = 0.05";
         assert!(build(ok).is_ok());
-        assert!(Venetian.build(&Parameters::new(heliodon::panel::default_values(Venetian.keys()), "")).is_ok());
+        assert!(Venetian.build(&Parameters::new(heliodon_core::panel::default_values(Venetian.keys()), "")).is_ok());
         assert_eq!(build(&ok.replace("diffuse = 0.05", "diffuse = 0.5")).unwrap_err().key, "diffuse");
         assert_eq!(build(&ok.replace("tilt = 30.0", "tilt = 95.0")).unwrap_err().key, "tilt");
         assert_eq!(build("tilt = 1.0").unwrap_err().key, "slat_width");

@@ -4,18 +4,8 @@
 
 use std::sync::Arc;
 
-use heliodon::bevy::prelude::{App, Plugin};
-use heliodon::ecs::RegisterPanel;
-use heliodon::glam::DVec3;
-use heliodon::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters};
-
-pub struct GreyFilterPlugin;
-
-impl Plugin for GreyFilterPlugin {
-    fn build(&self, app: &mut App) {
-        app.register_panel(GreyFilter);
-    }
-}
+use heliodon_core::glam::DVec3;
+use heliodon_core::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters};
 
 pub struct GreyFilter;
 

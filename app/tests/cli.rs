@@ -1,0 +1,365 @@
+//! The command line, through the `heliodon` executable (one runner,
+//! tests/support/cli.rs): every subcommand's output in the contract's
+//! formats against the library, and bad input answered in one line with a
+//! non-zero exit.
+
+#[path = "../../tests/support/cli.rs"]
+mod cli;
+#[path = "../../tests/support/fixture.rs"]
+mod fixture;
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use heliodon_core::light::{LightModel, LightSettings};
+use heliodon_core::panel::PanelCatalog;
+use heliodon_core::scene::{Scene, load_scene};
+use heliodon_core::site::Site;
+use heliodon_core::sky::{Sky, SkySpec};
+use heliodon_core::sun::solar_position;
+use heliodon_core::time::{Date, LocalDateTime, TimeOfDay};
+
+use cli::{Run, heliodon, root};
+use fixture::{OBJ, fixture, scene_toml};
+
+/// A light cache for the commands whose caching is not what is tested.
+fn scratch() -> PathBuf {
+    Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_cache")
+}
+
+fn bundled_scene(name: &str) -> PathBuf {
+    root().join("assets/scenes").join(name).join("scene.toml")
+}
+
+fn load(path: &Path) -> Arc<Scene> {
+    Arc::new(load_scene(path, &PanelCatalog::new()).unwrap().scene)
+}
+
+/// The validation room (tests/fixtures/sideroom).
+fn sideroom() -> PathBuf {
+    root().join("tests/fixtures/sideroom/scene.toml")
+}
+
+fn sky_at(scene: &Scene, spec: &SkySpec, date: &str, time: &str) -> Sky {
+    let when = LocalDateTime { date: Date::parse(date).unwrap(), time: TimeOfDay::parse(time).unwrap() };
+    heliodon_core::sky::sky_at(&scene.site, spec, &when).1.unwrap()
+}
+
+const BOSTON: [&str; 6] = ["--latitude", "42.36", "--longitude", "-71.06", "--timezone", "-5"];
+
+// Panel scenes: a floor and a material `upper` given as a panel table body.
+const PANEL_OBJ: &str = "mtllib room.mtl\nusemtl floor\nv 0 0 0\nv 4 0 0\nv 4 6 0\nv 0 6 0\nf 1 2 3 4\nusemtl upper\nv 0 0 2\nv 4 0 2\nv 4 0 3\nv 0 0 3\nf 5 6 7 8\n";
+const PANEL_MTL: &str = "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl upper\nKd 0.5 0.5 0.5\n";
+
+// ---- info ------------------------------------------------------------------------
+
+#[test]
+fn info_summarises_each_bundled_scene() {
+    let Run { code, out, err } = heliodon(&["info", "assets/scenes/test_room/scene.toml"], &scratch());
+    assert_eq!(code, 0, "{err}");
+    assert!(err.is_empty(), "{err}");
+    for expected in [
+        "scene      Small test room",
+        "triangles  80",
+        "  diffuse  3: ",
+        "  glass    1: glass τ=0.88",
+        "windows    6, 4.59 m² in all",
+        "facing S (azimuth 180°)",
+        "sensors    65 (3 point, 2 area, grids: workplane 60)",
+        "latitude 42.3600°, longitude -71.0600°, UTC-5",
+    ] {
+        assert!(out.contains(expected), "missing {expected:?} in\n{out}");
+    }
+    let patches: usize = out
+        .lines()
+        .find_map(|l| l.strip_prefix("patches    "))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .expect("patch line");
+    assert!(patches > 400, "{out}");
+    let Run { code, out, .. } = heliodon(&["info", "assets/scenes/office/scene.toml"], &scratch());
+    assert_eq!(code, 0);
+    assert!(out.contains("windows    12, 24.88 m² in all") && out.contains("facing W (azimuth 270°)"), "{out}");
+    let Run { code, out, .. } = heliodon(&["info", "assets/scenes/living_room/scene.toml"], &scratch());
+    assert_eq!(code, 0);
+    assert!(out.contains("up Y, scale 0.01 m/unit") && out.contains("windows    16"), "{out}");
+}
+
+#[test]
+fn cli_errors_are_one_line_and_non_zero() {
+    let f = fixture("cli_kind", &scene_toml("\n[materials.wall]\nkind = \"stone\"\n"), OBJ);
+    let scene = f.scene();
+    let Run { code, out, err } = heliodon(&["info", scene.to_str().unwrap()], &scratch());
+    assert_ne!(code, 0);
+    assert!(out.is_empty());
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.starts_with(&format!("error: {}:11: materials.wall.kind: unknown material kind 'stone'", scene.display())), "{err}");
+    let Run { code, err, .. } = heliodon(&["info", "no/such/scene.toml"], &scratch());
+    assert_ne!(code, 0);
+    assert_eq!(err.trim_end(), "error: no/such/scene.toml: cannot read scene file: not found");
+    let Run { code, err, .. } = heliodon(&["info", "assets/scenes/test_room/scene.toml", "--bogus"], &scratch());
+    assert_eq!(code, 2);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("--bogus"), "{err}");
+    let Run { code, err, .. } = heliodon(&["info"], &scratch());
+    assert_eq!(code, 2);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    // Warnings go to stderr and do not fail the command.
+    let f = fixture("cli_warning", &scene_toml("\n[materials.marble]\nkind = \"diffuse\"\nreflectance = 0.7\n"), OBJ);
+    let Run { code, err, .. } = heliodon(&["info", f.scene().to_str().unwrap()], &scratch());
+    assert_eq!(code, 0);
+    assert!(err.starts_with("warning: ") && err.contains("materials.marble"), "{err}");
+}
+
+#[test]
+fn help_lists_only_what_exists() {
+    let Run { code, out, .. } = heliodon(&["--help"], &scratch());
+    assert_eq!(code, 0);
+    // Subcommands arrive with their features: none is listed before it exists.
+    let commands: Vec<&str> = out
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next())
+        .collect();
+    assert_eq!(commands, ["view", "info", "sensors", "export-radiance", "render", "sun", "help"], "{out}");
+}
+
+// ---- sun -------------------------------------------------------------------------
+
+#[test]
+fn sun_command_prints_the_contract_formats() {
+    let mut args = vec!["sun"];
+    args.extend(BOSTON);
+    args.extend(["--date", "2026-03-21", "--time", "12:00"]);
+    let site = Site::new(42.36, -71.06, -5.0);
+    let expected =
+        solar_position(&site, &LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() });
+
+    let Run { code, out, err } = heliodon(&[args.as_slice(), &["--format", "csv"]].concat(), &scratch());
+    assert_eq!(code, 0, "{err}");
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], "altitude_deg,azimuth_deg");
+    assert_eq!(lines.len(), 2);
+    let values: Vec<f64> = lines[1].split(',').map(|v| v.parse().unwrap()).collect();
+    assert!((values[0] - expected.altitude).abs() < 1e-6 && (values[1] - expected.azimuth).abs() < 1e-6);
+
+    let Run { code, out, .. } = heliodon(&[args.as_slice(), &["--format", "json"]].concat(), &scratch());
+    assert_eq!(code, 0);
+    assert_eq!(out.trim(), format!("{{\"altitude_deg\": {:.6}, \"azimuth_deg\": {:.6}}}", expected.altitude, expected.azimuth));
+
+    let Run { code, out, .. } = heliodon(&args, &scratch());
+    assert_eq!(code, 0);
+    assert!(out.contains(&format!("altitude   {:9.4}°", expected.altitude)), "{out}");
+
+    let mut day = vec!["sun"];
+    day.extend(BOSTON);
+    day.extend(["--date", "2026-03-21", "--day", "--format", "csv"]);
+    let Run { code, out, .. } = heliodon(&day, &scratch());
+    assert_eq!(code, 0);
+    let rows: Vec<&str> = out.lines().collect();
+    assert_eq!(rows[0], "event,time,altitude_deg,azimuth_deg");
+    assert!(
+        rows[1].starts_with("sunrise,05:45:42,") && rows[2].starts_with("noon,11:51:19,") && rows[3].starts_with("sunset,17:57:41,"),
+        "{out}"
+    );
+}
+
+#[test]
+fn sun_command_rejects_bad_input_in_one_line() {
+    let cases: [(&[&str], &str); 8] = [
+        (&["--latitude", "95", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21", "--time", "12:00"], "--latitude"),
+        (&["--latitude", "10", "--longitude", "-181", "--timezone", "0", "--date", "2026-03-21", "--time", "12:00"], "--longitude"),
+        (&["--latitude", "10", "--longitude", "0", "--timezone", "-15", "--date", "2026-03-21", "--time", "12:00"], "--timezone"),
+        (
+            &["--latitude", "10", "--longitude", "0", "--timezone", "0", "--date", "2026-02-30", "--time", "12:00"],
+            "February 2026 has 28 days",
+        ),
+        (&["--latitude", "10", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21", "--time", "24:01"], "outside 00:00-24:00"),
+        (&["--latitude", "10", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21", "--time", "7pm"], "--time"),
+        (&["--latitude", "10", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21"], "--time"),
+        (&["--latitude", "nan", "--longitude", "0", "--timezone", "0", "--date", "2026-03-21", "--time", "12:00"], "--latitude"),
+    ];
+    for (args, expected) in cases {
+        let Run { code, out, err } = heliodon(&[&["sun"], args].concat(), &scratch());
+        assert_eq!(code, 2, "{args:?}");
+        assert!(out.is_empty());
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.starts_with("error: ") && err.contains(expected), "{args:?}: {err}");
+    }
+}
+
+// ---- sensors and export-radiance --------------------------------------------------
+
+#[test]
+fn sensors_command_prints_the_contract_csv_and_shares_one_precomputation() {
+    let cache = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sensors_cli_cache");
+    let _ = std::fs::remove_dir_all(&cache);
+    let scene_path = sideroom();
+    let scene = scene_path.to_str().unwrap();
+    let args = ["sensors", scene, "--date", "2026-03-21", "--time", "12:00", "--sky", "overcast", "--format", "csv"];
+    let Run { code, out: first, err } = heliodon(&args, &cache);
+    assert_eq!(code, 0, "{err}");
+    let lines: Vec<&str> = first.lines().collect();
+    assert_eq!(lines[0], "name,illuminance_lux,direct_sun_lux,direct_sky_lux,indirect_lux");
+    assert_eq!(lines.len(), 1 + 19);
+    for line in &lines[1..] {
+        let f: Vec<&str> = line.split(',').collect();
+        let v: Vec<f64> = f[1..].iter().map(|x| x.parse().unwrap()).collect();
+        assert!(v.iter().all(|x| x.is_finite() && *x >= 0.0));
+        assert!((v[0] - v[1] - v[2] - v[3]).abs() <= 0.2, "parts add up: {line}");
+        assert_eq!(v[1], 0.0, "no sun under an overcast sky");
+    }
+    // The same from the library.
+    let model = LightModel::precompute(load(&scene_path), LightSettings::default()).unwrap();
+    let expected = model.solve(&sky_at(&model.scene, &SkySpec::Overcast, "2026-03-21", "12:00"), None);
+    assert_eq!(
+        lines[1],
+        format!(
+            "s00,{:.1},{:.1},{:.1},{:.1}",
+            expected.sensors[0].total, expected.sensors[0].direct_sun, expected.sensors[0].direct_sky, expected.sensors[0].indirect
+        )
+    );
+    // A second run reads the cache and says the same.
+    let Run { out: second, .. } = heliodon(&args, &cache);
+    assert_eq!(first, second);
+    assert!(std::fs::read_dir(&cache).unwrap().count() == 1);
+    // Several times and dates in one call.
+    let Run { code, out: many, .. } = heliodon(
+        &["sensors", scene, "--date", "2026-03-21,2026-06-21", "--time", "09:00,12:00", "--sky", "clear", "--format", "csv"],
+        &cache,
+    );
+    assert_eq!(code, 0);
+    let rows: Vec<&str> = many.lines().collect();
+    assert_eq!(rows[0], "date,time,name,illuminance_lux,direct_sun_lux,direct_sky_lux,indirect_lux");
+    assert_eq!(rows.len(), 1 + 4 * 19);
+    assert!(rows[1].starts_with("2026-03-21,09:00:00,s00,") && rows[rows.len() - 1].starts_with("2026-06-21,12:00:00,ceiling_centre,"));
+}
+
+#[test]
+fn sensors_command_rejects_bad_input_in_one_line() {
+    let cache = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sensors_cli_cache_bad");
+    let scene_path = sideroom();
+    let scene = scene_path.to_str().unwrap();
+    let cases: [(&[&str], &str); 5] = [
+        (&["sensors", scene, "--date", "2026-03-21", "--time", "12:00", "--sky", "sunny"], "unknown sky 'sunny'"),
+        (&["sensors", scene, "--date", "2026-03-21", "--time", "12:00", "--sky", "perez"], "--sky perez"),
+        (&["sensors", scene, "--date", "2026-03-21", "--time", "12:00", "--sky", "perez", "--dni", "-3", "--dhi", "100"], "non-negative"),
+        (&["sensors", "no/such/scene.toml", "--date", "2026-03-21", "--time", "12:00"], "no/such/scene.toml: cannot read scene file"),
+        (&["sensors", scene, "--date", "2026-03-21", "--time", "25:00"], "--time"),
+    ];
+    for (args, expected) in cases {
+        let Run { code, out, err } = heliodon(args, &cache);
+        assert_ne!(code, 0, "{args:?}");
+        assert!(out.is_empty(), "{out}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.starts_with("error: ") && err.contains(expected), "{args:?}: {err}");
+    }
+    // Perez light with the sun down is refused, naming the case.
+    let Run { code, err, .. } =
+        heliodon(&["sensors", scene, "--date", "2026-03-21", "--time", "03:00", "--sky", "perez", "--dni", "100", "--dhi", "50"], &cache);
+    assert_ne!(code, 0);
+    assert!(err.contains("2026-03-21 03:00:00") && err.contains("below the horizon"), "{err}");
+}
+
+#[test]
+fn export_radiance_writes_the_same_model_and_sky() {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("export_test_room");
+    let _ = std::fs::remove_dir_all(&out);
+    let scene_path = bundled_scene("test_room");
+    let run = heliodon(
+        &[
+            "export-radiance",
+            scene_path.to_str().unwrap(),
+            "--date",
+            "2026-03-21",
+            "--time",
+            "10:00",
+            "--sky",
+            "clear",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &scratch(),
+    );
+    assert_eq!(run.code, 0, "{}", run.err);
+    let scene = load(&scene_path);
+    let rad = std::fs::read_to_string(out.join("scene.rad")).unwrap();
+    assert_eq!(rad.matches(" polygon ").count(), scene.triangles.len());
+    assert!(rad.contains("void glass m_glass\n0\n0\n3 0.9"), "Radiance transmissivity of 88% glass is 0.96");
+    let sky_rad = std::fs::read_to_string(out.join("sky.rad")).unwrap();
+    let sky = sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-03-21", "10:00");
+    let (zenith, f2) = sky.gensky_arguments().unwrap();
+    assert!(sky_rad.contains(&format!("7 1 {zenith:.9e} {:.9e} {f2:.9e}", sky.ground_radiance)), "{sky_rad}");
+    assert!(sky_rad.contains(&format!("3 {r:.6e} {r:.6e} {r:.6e}", r = sky.sun.unwrap().radiance)));
+    let points = std::fs::read_to_string(out.join("sensors.pts")).unwrap();
+    let index = std::fs::read_to_string(out.join("sensors.txt")).unwrap();
+    let expected: usize = scene.sensors.iter().map(|s| if s.size.is_some() { 16 } else { 1 }).sum();
+    assert_eq!(points.lines().count(), expected);
+    assert_eq!(index.lines().count(), scene.sensors.len());
+    assert!(std::fs::read_to_string(out.join("run.sh")).unwrap().contains("rtrace -h -I -ab 16"));
+    // The floor sensor lies on the floor: it is exported lifted 1 cm, as heliodon reads it.
+    let floor = index.lines().position(|l| l.starts_with("floor-centre ")).unwrap();
+    let first_point: usize = index.lines().take(floor).map(|l| l.split(' ').nth(1).unwrap().parse::<usize>().unwrap()).sum();
+    let z: f64 = points.lines().nth(first_point).unwrap().split(' ').nth(2).unwrap().parse().unwrap();
+    assert!((z - 0.01).abs() < 1e-6, "{z}");
+}
+
+// ---- panels ----------------------------------------------------------------------
+
+/// A scene whose material `upper` is the given panel table body.
+fn panel_scene(name: &str, upper: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("panels_{name}"));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("room.obj"), PANEL_OBJ).unwrap();
+    std::fs::write(dir.join("room.mtl"), PANEL_MTL).unwrap();
+    let text = format!(
+        "name = \"Panel room\"\n[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n[model]\nobj = \"room.obj\"\n\n[materials.upper]\nkind = \"panel\"\n{upper}"
+    );
+    std::fs::write(dir.join("scene.toml"), text).unwrap();
+    dir.join("scene.toml")
+}
+
+#[test]
+fn the_executable_knows_the_built_in_panels() {
+    let path = panel_scene("prismatic", "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n");
+    let Run { code, out, err } = heliodon(&["info", path.to_str().unwrap()], &scratch());
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("panel    1"), "{out}");
+
+    let path = panel_scene("unknown", "panel = \"lenticular\"\n");
+    let Run { code, err, .. } = heliodon(&["info", path.to_str().unwrap()], &scratch());
+    assert_ne!(code, 0);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains("scene.toml:11: materials.upper.panel: no panel named 'lenticular' is registered (registered: bsdf, laser_cut, prismatic, venetian)"), "{err}");
+}
+
+#[test]
+fn bad_panel_keys_give_one_line_naming_the_key() {
+    let cases = [
+        (
+            "range",
+            "panel = \"prismatic\"\nfacet_angles = [40.0, 95.0]\n",
+            "scene.toml:12: materials.upper.facet_angles: 95 is outside 0..89",
+        ),
+        ("missing", "panel = \"prismatic\"\n", "scene.toml:9: materials.upper.facet_angles: is required"),
+        (
+            "unknown",
+            "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\nfacet_count = 3\n",
+            "materials.upper.facet_count: is not a key of panel 'prismatic'",
+        ),
+        (
+            "type",
+            "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\nrefractive_index = \"acrylic\"\n",
+            "materials.upper.refractive_index: must be a number",
+        ),
+    ];
+    for (name, body, expected) in cases {
+        let path = panel_scene(name, body);
+        let Run { code, err, .. } = heliodon(&["info", path.to_str().unwrap()], &scratch());
+        assert_ne!(code, 0, "{name}");
+        assert_eq!(err.trim().lines().count(), 1, "{name}: {err}");
+        assert!(err.contains(expected), "{name}: {err}");
+    }
+}

@@ -1,0 +1,131 @@
+//! The light engine's costs: precomputation and relighting for the bundled
+//! scenes and a generated floor of offices (≥ 50,000 patches), and that
+//! building's memory.
+
+#[path = "../../tests/support/quad_obj.rs"]
+mod quad_obj;
+
+use quad_obj::QuadObj;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use heliodon_core::light::{LightModel, LightSettings, Lighting};
+use heliodon_core::panel::PanelCatalog;
+use heliodon_core::scene::{Scene, load_scene};
+use heliodon_core::sky::{Sky, SkySpec};
+use heliodon_core::sun::solar_position;
+use heliodon_core::time::{Date, LocalDateTime, TimeOfDay};
+
+fn sky_at(scene: &Scene, hours: f64) -> Sky {
+    let when = LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(hours).unwrap() };
+    let sun = solar_position(&scene.site, &when);
+    Sky::new(&SkySpec::Clear { turbidity: 2.45 }, sun.altitude, sun.azimuth, scene.site.ground_reflectance, 80).unwrap()
+}
+
+/// A floor of offices: 60 × 30 m, a corridor down the middle, 15 offices of
+/// 4 × 12 m on each side with two windows each, a desk per office; patches
+/// of 0.25 m. Written as OBJ + scene files into `dir`.
+fn large_building(dir: &Path) -> PathBuf {
+    let (w, d, h) = (60.0f64, 30.0f64, 3.0f64);
+    let mut obj = QuadObj::new("model.mtl");
+    obj.quad("floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
+    obj.quad("ceiling", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
+    obj.quad("wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
+    obj.quad("wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
+    for (y, inward) in [(0.0, 1.0), (d, -1.0)] {
+        for k in 0..15 {
+            let x0 = 4.0 * k as f64;
+            // Façade: sill wall, two windows, head wall.
+            let facade = |z0: f64, z1: f64, xa: f64, xb: f64| {
+                if inward > 0.0 {
+                    [[xb, y, z0], [xa, y, z0], [xa, y, z1], [xb, y, z1]]
+                } else {
+                    [[xa, y, z0], [xb, y, z0], [xb, y, z1], [xa, y, z1]]
+                }
+            };
+            obj.quad("wall", facade(0.0, 0.9, x0, x0 + 4.0));
+            obj.quad("wall", facade(2.4, h, x0, x0 + 4.0));
+            for (xa, xb, material) in [
+                (x0, x0 + 0.3, "wall"),
+                (x0 + 0.3, x0 + 1.9, "glass"),
+                (x0 + 1.9, x0 + 2.1, "wall"),
+                (x0 + 2.1, x0 + 3.7, "glass"),
+                (x0 + 3.7, x0 + 4.0, "wall"),
+            ] {
+                obj.quad(material, facade(0.9, 2.4, xa, xb));
+            }
+            // Partition to the next office and the corridor wall.
+            let (ya, yb) = if inward > 0.0 { (0.0, 12.0) } else { (d - 12.0, d) };
+            if k > 0 {
+                obj.quad("partition", [[x0, ya, 0.0], [x0, yb, 0.0], [x0, yb, h], [x0, ya, h]]);
+            }
+            let yc = if inward > 0.0 { 12.0 } else { d - 12.0 };
+            obj.quad("partition", [[x0, yc, 0.0], [x0 + 4.0, yc, 0.0], [x0 + 4.0, yc, h], [x0, yc, h]]);
+            // A desk top.
+            let yd = y + inward * 3.0;
+            obj.quad(
+                "desk",
+                [[x0 + 1.0, yd - 0.4, 0.75], [x0 + 3.0, yd - 0.4, 0.75], [x0 + 3.0, yd + 0.4, 0.75], [x0 + 1.0, yd + 0.4, 0.75]],
+            );
+        }
+    }
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(dir.join("model.obj"), obj.text()).unwrap();
+    std::fs::write(
+        dir.join("model.mtl"),
+        "newmtl floor\nKd 0.2 0.2 0.2\nnewmtl ceiling\nKd 0.8 0.8 0.8\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl partition\nKd 0.6 0.6 0.6\nnewmtl desk\nKd 0.4 0.35 0.3\nnewmtl glass\nd 0.12\n",
+    )
+    .unwrap();
+    let mut scene = String::from(
+        "name = \"Office floor\"\n[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n[model]\nobj = \"model.obj\"\n[lighting]\npatch_size = 0.25\n",
+    );
+    let _ = writeln!(scene, "[[sensor_grids]]\nname = \"workplane\"\nmin = [0.0, 0.0]\nmax = [60.0, 30.0]\nheight = 0.8\nspacing = 2.0");
+    std::fs::write(dir.join("scene.toml"), scene).unwrap();
+    dir.join("scene.toml")
+}
+
+fn peak_memory_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    Some(line.split_whitespace().nth(1)?.parse::<f64>().ok()? / 1024.0)
+}
+
+fn relight(model: &LightModel, scene: &Scene, previous: &Lighting, hours: f64) -> Lighting {
+    model.solve(&sky_at(scene, hours), Some(previous))
+}
+
+fn bench(c: &mut Criterion) {
+    let mut group = c.benchmark_group("light");
+    group.sample_size(10).measurement_time(Duration::from_secs(20));
+    for name in heliodon_core::BUNDLED_SCENES {
+        let scene = Arc::new(load_scene(&heliodon_core::bundled_scene(name), &PanelCatalog::new()).unwrap().scene);
+        group.bench_function(format!("precompute {name} ({} patches)", scene.patches.patches.len()), |b| {
+            b.iter(|| LightModel::precompute(scene.clone(), LightSettings::default()).unwrap())
+        });
+        let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
+        let before = model.solve(&sky_at(&scene, 10.0), None);
+        group.bench_function(format!("relight {name} (sun moves 10 min)"), |b| {
+            b.iter(|| relight(&model, &scene, &before, 10.0 + 1.0 / 6.0))
+        });
+    }
+    let path = large_building(&std::env::temp_dir().join("heliodon-bench-office-floor"));
+    let scene = Arc::new(load_scene(&path, &PanelCatalog::new()).unwrap().scene);
+    let patches = scene.patches.patches.len();
+    let start = Instant::now();
+    let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
+    println!("large building: {patches} patches, {} sensors, precompute {:.1} s", scene.sensors.len(), start.elapsed().as_secs_f64());
+    let before = model.solve(&sky_at(&scene, 10.0), None);
+    group.bench_function(format!("relight large building ({patches} patches, sun moves 10 min)"), |b| {
+        b.iter(|| relight(&model, &scene, &before, 10.0 + 1.0 / 6.0))
+    });
+    group.finish();
+    if let Some(mib) = peak_memory_mib() {
+        println!("peak memory (VmHWM) after the large building: {mib:.0} MiB");
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,322 @@
+//! The precomputation on disk. A model's gathers (sky coefficients, form
+//! factors, sensor rays) are stored under a key hashed from the scene file,
+//! the OBJ, the MTLs, the light settings and this format's version; the BVH
+//! is rebuilt on load. A file whose header, length or checksum does not
+//! match is rebuilt, never trusted.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use super::gather::{Gather, SensorGeometry};
+use super::{LightModel, LightSettings};
+use crate::scene::{MaterialKind, Scene};
+use crate::sky::SkyPatches;
+
+const MAGIC: &[u8; 8] = b"HELIOLT\0";
+/// Bump when the model or its layout changes.
+const FORMAT: u32 = 4;
+
+/// What happened to the cache.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum CacheOutcome {
+    /// Loaded from disk.
+    Hit(PathBuf),
+    /// Computed and stored.
+    Stored(PathBuf),
+    /// A file was there but unusable (why); recomputed and replaced.
+    Rebuilt(PathBuf, String),
+    /// Computed; not stored (why: disabled, or the folder is not writable).
+    Skipped(String),
+}
+
+/// The default cache folder: `$HELIODON_CACHE_DIR`, else
+/// `$XDG_CACHE_HOME/heliodon`, else `~/.cache/heliodon`.
+pub fn default_dir() -> Option<PathBuf> {
+    if let Some(dir) = std::env::var_os("HELIODON_CACHE_DIR") {
+        return Some(PathBuf::from(dir));
+    }
+    if let Some(dir) = std::env::var_os("XDG_CACHE_HOME") {
+        return Some(PathBuf::from(dir).join("heliodon"));
+    }
+    std::env::var_os("HOME").map(|home| PathBuf::from(home).join(".cache/heliodon"))
+}
+
+/// FNV-1a, 64 bits: stable across platforms and Rust versions.
+struct Fnv(u64);
+
+impl Fnv {
+    fn new() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+
+    fn bytes(&mut self, data: &[u8]) -> &mut Self {
+        for &b in data {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        self
+    }
+
+    fn u64(&mut self, v: u64) -> &mut Self {
+        self.bytes(&v.to_le_bytes())
+    }
+}
+
+/// The key of a scene's precomputation: its files' bytes and the settings
+/// that shape the result (not the thread count).
+pub fn key(scene: &Scene, settings: &LightSettings) -> std::io::Result<u64> {
+    let mut hash = Fnv::new();
+    hash.bytes(MAGIC).u64(u64::from(FORMAT)).bytes(env!("CARGO_PKG_VERSION").as_bytes());
+    for path in std::iter::once(&scene.files.scene).chain(std::iter::once(&scene.files.obj)).chain(&scene.files.mtls) {
+        let data = fs::read(path)?;
+        hash.u64(data.len() as u64).bytes(&data);
+    }
+    // Materials edited at run time: what the gathers depend on (which
+    // materials pass light, and glass transmittance; not reflectances), and
+    // which surfaces have which.
+    for material in &scene.materials {
+        match &material.kind {
+            MaterialKind::Diffuse { .. } => hash.u64(0),
+            MaterialKind::Glass { transmittance } => hash.u64(1).u64(u64::from(transmittance.to_bits())),
+            MaterialKind::Panel { .. } => hash.u64(2),
+        };
+    }
+    // Surfaces given materials of their own at run time.
+    for surface in &scene.surfaces {
+        hash.u64(u64::from(surface.material));
+    }
+    hash.u64(settings.rays_per_patch as u64)
+        .u64(settings.rays_per_sensor as u64)
+        .u64(settings.sun_samples_per_patch as u64)
+        .u64(settings.area_sensor_sun_grid as u64)
+        .u64(u64::from(settings.sky_subdivision))
+        .u64(settings.max_iterations as u64)
+        .u64(settings.tolerance.to_bits());
+    Ok(hash.0)
+}
+
+/// Precomputes `scene`, going through the cache in `dir` (none: no cache).
+pub fn precompute_cached(
+    scene: Arc<Scene>,
+    settings: LightSettings,
+    dir: Option<&Path>,
+    progress: &(dyn Fn(f64) + Sync),
+) -> Result<(LightModel, CacheOutcome), String> {
+    settings.check()?;
+    let Some(dir) = dir else {
+        return Ok((LightModel::precompute_with_progress(scene, settings, progress)?, CacheOutcome::Skipped("disabled".into())));
+    };
+    let key = match key(&scene, &settings) {
+        Ok(key) => key,
+        Err(e) => {
+            let model = LightModel::precompute_with_progress(scene, settings, progress)?;
+            return Ok((model, CacheOutcome::Skipped(format!("cannot read the scene's files to key the cache: {e}"))));
+        }
+    };
+    let path = dir.join(format!("light-{key:016x}.bin"));
+    let mut rebuilt = None;
+    if let Ok(bytes) = fs::read(&path) {
+        match decode(&bytes, key) {
+            Ok(payload) => match LightModel::from_payload(scene.clone(), settings, &payload) {
+                Some(model) => return Ok((model, CacheOutcome::Hit(path))),
+                None => rebuilt = Some("its contents do not fit the scene".to_string()),
+            },
+            Err(why) => rebuilt = Some(why),
+        }
+    }
+    let model = LightModel::precompute_with_progress(scene, settings, progress)?;
+    let stored = fs::create_dir_all(dir).and_then(|_| {
+        // Write then rename, so a reader never sees half a file.
+        let partial = path.with_extension(format!("tmp{}", std::process::id()));
+        fs::write(&partial, encode(&model.payload(), key))?;
+        fs::rename(&partial, &path)
+    });
+    let outcome = match (stored, rebuilt) {
+        (Err(e), _) => CacheOutcome::Skipped(format!("cannot write {}: {e}", path.display())),
+        (Ok(()), Some(why)) => CacheOutcome::Rebuilt(path, why),
+        (Ok(()), None) => CacheOutcome::Stored(path),
+    };
+    Ok((model, outcome))
+}
+
+fn encode(payload: &[u8], key: u64) -> Vec<u8> {
+    let mut out = Vec::with_capacity(payload.len() + 36);
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&FORMAT.to_le_bytes());
+    out.extend_from_slice(&key.to_le_bytes());
+    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    out.extend_from_slice(&Fnv::new().bytes(payload).0.to_le_bytes());
+    out.extend_from_slice(payload);
+    out
+}
+
+fn decode(bytes: &[u8], key: u64) -> Result<Vec<u8>, String> {
+    if bytes.len() < 36 || &bytes[..8] != MAGIC {
+        return Err("not a heliodon light cache".into());
+    }
+    let u32_at = |i: usize| u32::from_le_bytes(bytes[i..i + 4].try_into().expect("4 bytes"));
+    let u64_at = |i: usize| u64::from_le_bytes(bytes[i..i + 8].try_into().expect("8 bytes"));
+    if u32_at(8) != FORMAT {
+        return Err(format!("format {} (expected {FORMAT})", u32_at(8)));
+    }
+    if u64_at(12) != key {
+        return Err("key mismatch".into());
+    }
+    let payload = &bytes[36..];
+    if u64_at(20) != payload.len() as u64 {
+        return Err("truncated".into());
+    }
+    if u64_at(28) != Fnv::new().bytes(payload).0 {
+        return Err("checksum mismatch".into());
+    }
+    Ok(payload.to_vec())
+}
+
+/// Little-endian writer of the payload.
+#[derive(Default)]
+pub(super) struct Writer(pub Vec<u8>);
+
+impl Writer {
+    pub fn u32(&mut self, v: u32) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+
+    pub fn f32(&mut self, v: f32) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+
+    pub fn f64(&mut self, v: f64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+
+    pub fn vec3(&mut self, v: DVec3) {
+        self.f64(v.x);
+        self.f64(v.y);
+        self.f64(v.z);
+    }
+
+    pub fn pairs(&mut self, pairs: &[(u32, f32)]) {
+        self.u32(pairs.len() as u32);
+        for &(i, w) in pairs {
+            self.u32(i);
+            self.f32(w);
+        }
+    }
+
+    pub fn gather(&mut self, g: &Gather) {
+        self.pairs(&g.daylight_coefficients);
+        self.pairs(&g.form_factors);
+    }
+}
+
+/// Reader of the payload; `None` when it runs out.
+pub(super) struct Reader<'a>(pub &'a [u8]);
+
+impl Reader<'_> {
+    fn take(&mut self, n: usize) -> Option<&[u8]> {
+        if self.0.len() < n {
+            return None;
+        }
+        let (head, tail) = self.0.split_at(n);
+        self.0 = tail;
+        Some(head)
+    }
+
+    pub fn u32(&mut self) -> Option<u32> {
+        self.take(4).map(|b| u32::from_le_bytes(b.try_into().expect("4 bytes")))
+    }
+
+    pub fn f32(&mut self) -> Option<f32> {
+        self.take(4).map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes")))
+    }
+
+    pub fn f64(&mut self) -> Option<f64> {
+        self.take(8).map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes")))
+    }
+
+    pub fn vec3(&mut self) -> Option<DVec3> {
+        Some(DVec3::new(self.f64()?, self.f64()?, self.f64()?))
+    }
+
+    pub fn pairs(&mut self) -> Option<Vec<(u32, f32)>> {
+        let n = self.u32()? as usize;
+        if n > self.0.len() / 8 {
+            return None;
+        }
+        (0..n).map(|_| Some((self.u32()?, self.f32()?))).collect()
+    }
+
+    pub fn gather(&mut self) -> Option<Gather> {
+        Some(Gather { daylight_coefficients: self.pairs()?, form_factors: self.pairs()? })
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+}
+
+impl LightModel {
+    /// The gathered data, for the cache.
+    fn payload(&self) -> Vec<u8> {
+        let mut w = Writer::default();
+        w.u32(self.side_gathers.len() as u32);
+        self.side_gathers.iter().for_each(|g| w.gather(g));
+        w.u32(self.sensors.len() as u32);
+        self.sensors.iter().for_each(|s| s.write(&mut w));
+        w.0
+    }
+
+    /// The model from cached data; `None` when it does not fit the scene.
+    fn from_payload(scene: Arc<Scene>, settings: LightSettings, payload: &[u8]) -> Option<Self> {
+        let mut r = Reader(payload);
+        let sides = r.u32()? as usize;
+        if sides != scene.patches.patches.len() * 2 {
+            return None;
+        }
+        let side_gathers = (0..sides).map(|_| r.gather()).collect::<Option<Vec<_>>>()?;
+        let sensor_count = r.u32()? as usize;
+        if sensor_count != scene.sensors.len() {
+            return None;
+        }
+        let sensors = (0..sensor_count).map(|_| SensorGeometry::read(&mut r)).collect::<Option<Vec<_>>>()?;
+        let bins = (scene.windows.len() as u32 + 1) * 2 * SkyPatches::reinhart(settings.sky_subdivision).len() as u32;
+        let patch_sides = sides as u32;
+        let fits = |g: &Gather| g.daylight_coefficients.iter().all(|b| b.0 < bins) && g.form_factors.iter().all(|s| s.0 < patch_sides);
+        let hits_fit = |s: &SensorGeometry| s.hits.iter().all(|h| h.0 < patch_sides);
+        if !r.is_empty() || !side_gathers.iter().all(fits) || !sensors.iter().all(|s| fits(&s.gather) && hits_fit(s)) {
+            return None;
+        }
+        let mut model = Self::empty(scene, settings);
+        model.side_gathers = side_gathers;
+        model.sensors = sensors;
+        Some(model)
+    }
+}
+
+impl SensorGeometry {
+    pub(super) fn write(&self, w: &mut Writer) {
+        w.u32(self.sun_points.len() as u32);
+        self.sun_points.iter().for_each(|&p| w.vec3(p));
+        w.vec3(self.normal);
+        w.gather(&self.gather);
+        w.u32(self.hits.len() as u32);
+        for &(side, weight, point) in &self.hits {
+            w.u32(side);
+            w.f32(weight);
+            point.iter().for_each(|&c| w.f32(c));
+        }
+    }
+
+    pub(super) fn read(r: &mut Reader) -> Option<Self> {
+        let count = |r: &mut Reader, size: usize| r.u32().map(|n| n as usize).filter(|&n| n <= r.0.len() / size);
+        let n = count(r, 24)?;
+        let sun_points = (0..n).map(|_| r.vec3()).collect::<Option<Vec<_>>>()?;
+        let normal = r.vec3()?;
+        let gather = r.gather()?;
+        let n = count(r, 20)?;
+        let hits = (0..n).map(|_| Some((r.u32()?, r.f32()?, [r.f32()?, r.f32()?, r.f32()?]))).collect::<Option<Vec<_>>>()?;
+        Some(Self { sun_points, normal, gather, hits })
+    }
+}

@@ -1,0 +1,77 @@
+//! Direct sky and ground light by daylight coefficients: each receiver's
+//! gathered shares of sky and ground bins ([`super::Gather`]) times the
+//! bins' radiance under the current sky. A bin seen through a panel window
+//! carries what the panel makes of the sky and sun instead (its group's sky
+//! transfer, [`super::panels`]).
+
+use std::f64::consts::PI;
+
+use super::LightModel;
+use super::gather::SkyKey;
+use crate::sky::{LUMINOUS_EFFICACY, Sky};
+
+/// Radiance behind gather keys ([`SkyKey`]) for one sky.
+pub(super) struct KeyRadiance {
+    bin_count: u32,
+    /// Per sphere bin.
+    bins: Vec<f64>,
+    /// Per panel group, per sphere bin: sky and ground seen through its windows.
+    panels: Vec<Vec<f64>>,
+    /// Per panel group: its diffusely transmitted sunlight's radiance.
+    panel_sun: Vec<f64>,
+    /// Per scene window: its panel group.
+    window_panel: Vec<Option<u32>>,
+}
+
+impl KeyRadiance {
+    /// Sky and ground radiance behind `key`.
+    pub(super) fn of(&self, key: u32) -> f64 {
+        let key = SkyKey::unpack(key, self.bin_count);
+        match key.window.and_then(|w| self.window_panel[w as usize]) {
+            Some(group) => self.panels[group as usize][key.bin as usize],
+            None => self.bins[key.bin as usize],
+        }
+    }
+
+    /// Diffusely transmitted sunlight behind `key` (through panels only).
+    pub(super) fn sun_of(&self, key: u32) -> f64 {
+        let key = SkyKey::unpack(key, self.bin_count);
+        key.window.and_then(|w| self.window_panel[w as usize]).map_or(0.0, |group| self.panel_sun[group as usize])
+    }
+}
+
+impl LightModel {
+    /// Each sensor's direct sky and ground light in lux, split by where it
+    /// comes from: `(None, lux)` straight from outside, `(Some(k), lux)`
+    /// through window `k` of [`Scene::windows`]. Sums to `direct_sky`.
+    pub fn sky_through_windows(&self, sky: &Sky) -> Vec<Vec<(Option<u32>, f64)>> {
+        let seen = self.key_radiance(sky);
+        self.sensors
+            .iter()
+            .map(|geometry| {
+                let mut by_window: Vec<(Option<u32>, f64)> = Vec::new();
+                for &(k, w) in &geometry.gather.daylight_coefficients {
+                    let key = SkyKey::unpack(k, self.bin_count());
+                    let lux = PI * f64::from(w) * seen.of(k) * LUMINOUS_EFFICACY;
+                    match by_window.last_mut() {
+                        Some(last) if last.0 == key.window => last.1 += lux,
+                        _ => by_window.push((key.window, lux)),
+                    }
+                }
+                by_window
+            })
+            .collect()
+    }
+
+    /// The radiance behind each gather key under `sky`: a bin's own, or
+    /// through a panel window what the panel makes of the sky and sun.
+    pub(super) fn key_radiance(&self, sky: &Sky) -> KeyRadiance {
+        let mut bins = Vec::with_capacity(self.bin_count() as usize);
+        self.sky_bins.integrate_sphere_into(sky, &mut bins);
+        let sun = sky.sun.filter(|s| s.direction.z > 0.0);
+        let panels = self.panel_groups.iter().map(|g| g.radiance_through(&self.sky_bins, &bins)).collect();
+        let panel_sun = self.panel_groups.iter().map(|g| g.sun_diffuse_radiance(sun.as_ref())).collect();
+        let window_panel = self.scene.windows.iter().map(|w| self.group_of_surface[w.surface as usize]).collect();
+        KeyRadiance { bin_count: self.bin_count(), bins, panels, panel_sun, window_panel }
+    }
+}

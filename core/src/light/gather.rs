@@ -1,0 +1,274 @@
+//! The gather: from every side of every diffuse patch and from every
+//! sensor, cosine-weighted hemisphere rays are followed through glass until
+//! they reach a diffuse patch side (a **form factor**: the share of the
+//! receiver's view that side fills) or leave the model (a **daylight
+//! coefficient**: the share that a sky or ground bin fills, keyed by the
+//! window the ray first crossed, see [`SkyKey`]). Both are stored sparse, as
+//! `(index, share)` rows of [`Gather`]. Done once per geometry; each
+//! receiver has its own seeded generator, so results do not depend on
+//! threads.
+
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use super::bvh::Tracer;
+use super::sampling::{Rng, cosine_directions, point_on_triangle};
+use super::{LightModel, LightSettings, MAX_GLASS_DEPTH, MIN_WEIGHT, SURFACE_OFFSET, Surface, par_map};
+use crate::scene::{Scene, Sensor};
+
+/// Sensors closer than this to a surface behind them read as lifted this far.
+const SENSOR_LIFT: f64 = 0.01;
+
+/// Where a receiver's hemisphere light comes from: the **daylight
+/// coefficients** (bins of the sky sphere, each through the window it was
+/// seen through, see [`SkyKey`]) and the **form factors** (patch sides),
+/// each with its share (the shares of all rays sum to at most 1). Shares
+/// through glass carry the glass's transmittance.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Gather {
+    /// Packed [`SkyKey`]s with their shares, sorted by key.
+    pub daylight_coefficients: Vec<(u32, f32)>,
+    /// Patch sides ([`side_of`]) with their shares, sorted by side.
+    pub form_factors: Vec<(u32, f32)>,
+}
+
+/// A sky or ground bin as a receiver sees it: straight (no window between,
+/// `window: None`) or through the first window its ray crossed. Packed into
+/// one `u32` as `slot · bin_count + bin`, slot 0 for none and `k + 1` for
+/// window `k` of [`Scene::windows`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SkyKey {
+    /// The first window the ray crossed (index into [`Scene::windows`]), if any.
+    pub window: Option<u32>,
+    /// Index into the sky sphere's bins ([`SkyPatches::sphere_bin`]).
+    pub bin: u32,
+}
+
+impl SkyKey {
+    pub(super) fn pack(self, bin_count: u32) -> u32 {
+        self.window.map_or(0, |w| w + 1) * bin_count + self.bin
+    }
+
+    pub(super) fn unpack(key: u32, bin_count: u32) -> Self {
+        let slot = key / bin_count;
+        Self { window: slot.checked_sub(1), bin: key % bin_count }
+    }
+}
+
+/// A ray that reached a diffuse patch side.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SideHit {
+    side: u32,
+    weight: f64,
+    point: DVec3,
+}
+
+impl Gather {
+    fn from_raw(mut coefficients: Vec<(u32, f64)>, hits: &[SideHit], rays: usize) -> Self {
+        let mut sides: Vec<(u32, f64)> = hits.iter().map(|h| (h.side, h.weight)).collect();
+        let merge = |v: &mut Vec<(u32, f64)>| -> Vec<(u32, f32)> {
+            v.sort_by_key(|e| e.0);
+            let mut out: Vec<(u32, f32)> = Vec::new();
+            for &(i, w) in v.iter() {
+                match out.last_mut() {
+                    Some(last) if last.0 == i => last.1 += (w / rays as f64) as f32,
+                    _ => out.push((i, (w / rays as f64) as f32)),
+                }
+            }
+            out
+        };
+        Self { daylight_coefficients: merge(&mut coefficients), form_factors: merge(&mut sides) }
+    }
+}
+
+/// A patch side: index `2·patch` for the side its normal points to, `2·patch + 1` for the other.
+pub fn side_of(patch: u32, back: bool) -> u32 {
+    2 * patch + u32::from(back)
+}
+
+/// What a sensor sees, gathered once.
+pub(super) struct SensorGeometry {
+    /// Points whose direct sun is averaged.
+    pub(super) sun_points: Vec<DVec3>,
+    pub(super) normal: DVec3,
+    pub(super) gather: Gather,
+    /// Where the sensor's rays meet patches, with their shares: the sun's
+    /// first bounce is evaluated at these points, not averaged over patches
+    /// (a sun patch right beside a sensor is what patch averages get wrong).
+    pub(super) hits: Vec<(u32, f32, [f32; 3])>,
+}
+
+impl LightModel {
+    /// Traces everything that does not depend on the sun and sky.
+    pub fn precompute(scene: Arc<Scene>, settings: LightSettings) -> Result<Self, String> {
+        Self::precompute_with_progress(scene, settings, &|_| {})
+    }
+
+    /// [`Self::precompute`], reporting the fraction done (0-1) now and then.
+    pub fn precompute_with_progress(scene: Arc<Scene>, settings: LightSettings, progress: &(dyn Fn(f64) + Sync)) -> Result<Self, String> {
+        settings.check()?;
+        let mut model = Self::empty(scene, settings);
+        let patches = &model.scene.patches.patches;
+        let total = patches.len() * 2 + model.scene.sensors.len();
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let tick = || {
+            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            if n.is_multiple_of(64) || n == total {
+                progress(n as f64 / total as f64);
+            }
+        };
+        model.side_gathers = par_map(model.settings.threads, patches.len() * 2, |side| {
+            let gather = model.gather_patch_side(side);
+            tick();
+            gather
+        });
+        let sensors = model.scene.sensors.clone();
+        model.sensors = par_map(model.settings.threads, sensors.len(), |i| {
+            let geometry = model.sensor_geometry(i, &sensors[i]);
+            tick();
+            geometry
+        });
+        Ok(model)
+    }
+
+    /// Follows a ray through glass, adding the sky bin it leaves by to
+    /// `coefficients` or the patch side it reaches to `hits`;
+    /// `window` is the first window it crossed.
+    #[allow(clippy::too_many_arguments)]
+    fn follow(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        weight: f64,
+        depth: u32,
+        window: Option<u32>,
+        coefficients: &mut Vec<(u32, f64)>,
+        hits: &mut Vec<SideHit>,
+    ) {
+        match self.tracer.closest(origin, dir, 1e-6) {
+            None => coefficients.push((SkyKey { window, bin: self.sky_bins.sphere_bin(dir) as u32 }.pack(self.bin_count()), weight)),
+            Some(hit) => {
+                let normal = self.patch_normal(hit.patch);
+                let cos = dir.dot(normal);
+                let point = origin + dir * hit.distance;
+                let crossed = window.or(self.window_of_surface[self.scene.patches.patches[hit.patch as usize].surface as usize]);
+                match self.surface_of_patch(hit.patch) {
+                    Surface::Diffuse(_) => hits.push(SideHit { side: side_of(hit.patch, cos > 0.0), weight, point }),
+                    Surface::Panel(_) if depth < MAX_GLASS_DEPTH => {
+                        self.follow(point + dir * SURFACE_OFFSET, dir, weight, depth + 1, crossed, coefficients, hits)
+                    }
+                    Surface::Glass(glass) if depth < MAX_GLASS_DEPTH => {
+                        let (t, r) = glass.at(cos);
+                        if weight * t > MIN_WEIGHT {
+                            self.follow(point + dir * SURFACE_OFFSET, dir, weight * t, depth + 1, crossed, coefficients, hits);
+                        }
+                        if weight * r > MIN_WEIGHT {
+                            let reflected = dir - 2.0 * cos * normal;
+                            self.follow(point + reflected * SURFACE_OFFSET, reflected, weight * r, depth + 1, window, coefficients, hits);
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
+
+    /// One patch side's gather: cosine-weighted rays from points spread over
+    /// the patch, each receiver with its own seeded generator.
+    fn gather_patch_side(&self, side: usize) -> Gather {
+        let patch_index = side / 2;
+        let patch = &self.scene.patches.patches[patch_index];
+        if !matches!(self.surfaces[patch.material as usize], Surface::Diffuse(_)) {
+            return Gather::default();
+        }
+        let normal = patch.normal.as_dvec3() * if side % 2 == 1 { -1.0 } else { 1.0 };
+        let triangles = self.patch_triangles(patch_index);
+        let mut rng = Rng::new(1, side as u64);
+        let directions = cosine_directions(normal, self.settings.rays_per_patch, &mut rng);
+        let (mut coefficients, mut hits) = (Vec::new(), Vec::new());
+        for dir in directions {
+            let point = sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET;
+            self.follow(point, dir, 1.0, 0, None, &mut coefficients, &mut hits);
+        }
+        Gather::from_raw(coefficients, &hits, self.settings.rays_per_patch)
+    }
+
+    /// A patch's render triangles with their cumulative areas.
+    pub(super) fn patch_triangles(&self, patch: usize) -> Vec<([DVec3; 3], f64)> {
+        let range = self.scene.patches.patches[patch].triangles.clone();
+        let mut total = 0.0;
+        self.scene.patches.triangles[range.start as usize..range.end as usize]
+            .iter()
+            .map(|t| {
+                let t = t.map(|v| v.as_dvec3());
+                total += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+                (t, total)
+            })
+            .collect()
+    }
+
+    /// A sensor's gather, its sun points and where its rays land.
+    fn sensor_geometry(&self, index: usize, sensor: &Sensor) -> SensorGeometry {
+        let normal = sensor.normal.as_dvec3();
+        let points = place_sensor(&self.tracer, sensor, 4);
+        let sun_points = match sensor.size {
+            Some(_) => place_sensor(&self.tracer, sensor, self.settings.area_sensor_sun_grid),
+            None => points.clone(),
+        };
+        let mut rng = Rng::new(2, index as u64);
+        let per_point = self.settings.rays_per_sensor.div_ceil(points.len());
+        let (mut coefficients, mut hits) = (Vec::new(), Vec::new());
+        for &point in &points {
+            for dir in cosine_directions(normal, per_point, &mut rng) {
+                self.follow(point, dir, 1.0, 0, None, &mut coefficients, &mut hits);
+            }
+        }
+        let rays = per_point * points.len();
+        let gather = Gather::from_raw(coefficients, &hits, rays);
+        let hits = hits.iter().map(|h| (h.side, (h.weight / rays as f64) as f32, h.point.as_vec3().to_array())).collect();
+        SensorGeometry { gather, sun_points, normal, hits }
+    }
+}
+
+/// Where a sensor measures: its position, or an n × n grid of cell centres
+/// over its square, lifted off a surface it lies on.
+fn place_sensor(tracer: &Tracer, sensor: &Sensor, n: usize) -> Vec<DVec3> {
+    let normal = sensor.normal.as_dvec3();
+    let [u, v] = sensor.axes.map(|a| a.as_dvec3());
+    let mut centre = sensor.position.as_dvec3();
+    // Lying on a surface (within the lift, facing away from it): lift it.
+    // Probe beside the point too, in case a ray down a shared edge slips between triangles.
+    let probes = [DVec3::ZERO, u * 1e-4, v * 1e-4, -(u + v) * 1e-4];
+    let gap = probes
+        .iter()
+        .filter_map(|&o| tracer.closest(centre + o + normal * SENSOR_LIFT, -normal, 0.0))
+        .map(|hit| hit.distance - SENSOR_LIFT)
+        .fold(f64::INFINITY, f64::min);
+    if gap <= SENSOR_LIFT * 0.01 {
+        centre += normal * (SENSOR_LIFT - gap.max(-SENSOR_LIFT)).max(0.0);
+    }
+    let Some(size) = sensor.size else { return vec![centre] };
+    let size = f64::from(size);
+    (0..n * n)
+        .map(|k| {
+            let (i, j) = ((k % n) as f64, (k / n) as f64);
+            centre + u * size * ((i + 0.5) / n as f64 - 0.5) + v * size * ((j + 0.5) / n as f64 - 0.5)
+        })
+        .collect()
+}
+
+/// Every sensor's measuring points as [`LightModel`] places them (area
+/// sensors: a 4 × 4 grid), for exporting them.
+pub fn sensor_points(scene: &Scene) -> Vec<Vec<DVec3>> {
+    let tracer = Tracer::new(&scene.patches);
+    scene.sensors.iter().map(|s| place_sensor(&tracer, s, 4)).collect()
+}
+
+/// A uniformly distributed point on triangles given with cumulative areas.
+pub(super) fn sample_area(triangles: &[([DVec3; 3], f64)], rng: &mut Rng) -> DVec3 {
+    let total = triangles.last().map_or(0.0, |t| t.1);
+    let pick = rng.next_f64() * total;
+    let index = triangles.partition_point(|t| t.1 < pick).min(triangles.len() - 1);
+    point_on_triangle(&triangles[index].0, rng.next_f64(), rng.next_f64())
+}

@@ -1,0 +1,250 @@
+//! The light engine: the light factored as the thesis does (chapter 3).
+//!
+//! How it works, in the order it runs:
+//! 0. **Windows** ([`windows`]): grouped by material and outward facing,
+//!    the one rule everything that groups windows uses.
+//! 1. **Gather** ([`gather`], once per geometry, [`LightModel::precompute`]):
+//!    from every side of every diffuse patch and from every sensor,
+//!    cosine-weighted hemisphere rays are followed through glass
+//!    (Radiance's `glass`, [`glass`]: transmitted and reflected) until they
+//!    reach a diffuse patch side (a form factor) or leave the model (a
+//!    daylight coefficient of a sky or ground bin, Reinhart MF:n above the
+//!    horizon and its mirror below). Cached on disk ([`cache`]).
+//! 2. **Direct light** per sun and sky ([`LightModel::relight`]): direct sun
+//!    by shadow rays through windows and along panel lobes ([`sun`],
+//!    [`panels`]), direct sky as the sparse product of daylight coefficients
+//!    and bin radiances ([`daylight`]).
+//! 3. **Interreflection** ([`solver`]): Jacobi iterations over the form
+//!    factors, RGB, warm-started from a previous solution
+//!    ([`Relight::step`]); sensors gather through their own rays, never
+//!    from the nearest patch.
+//!
+//! Results are deterministic: every receiver has its own seeded generator
+//! ([`sampling`]). Knobs: [`LightSettings`]. Plain Rust, no Bevy types.
+
+mod bvh;
+pub mod cache;
+pub mod daylight;
+pub mod gather;
+mod glass;
+pub mod panels;
+mod sampling;
+pub mod settings;
+pub mod solver;
+pub mod sun;
+pub mod windows;
+
+use std::sync::Arc;
+
+use glam::DVec3;
+
+pub use gather::{Gather, SkyKey, sensor_points, side_of};
+pub use glass::Glass;
+pub use panels::{PanelFrame, SunBeam};
+pub use settings::LightSettings;
+pub use solver::{Interreflection, Relight, form_factor_product};
+pub use windows::{WindowGroup, WindowGroups};
+
+use crate::scene::{MaterialKind, Scene};
+use crate::sky::SkyPatches;
+use bvh::Tracer;
+use gather::SensorGeometry;
+use sampling::{Rng, cosine_directions};
+
+/// Offset of ray origins off their surface, metres.
+const SURFACE_OFFSET: f64 = 1e-4;
+/// Glass interactions followed along one ray.
+const MAX_GLASS_DEPTH: u32 = 4;
+/// Branches carrying less than this share of a ray are dropped.
+const MIN_WEIGHT: f64 = 1e-4;
+
+/// What a material does to a ray that meets it.
+#[derive(Debug, Clone, Copy)]
+enum Surface {
+    Diffuse([f64; 3]),
+    Glass(Glass),
+    /// A panel window of this group: rays pass on (what they see beyond is
+    /// turned into the panel's light at relight time, see
+    /// `PanelGroup::radiance_through`); the sun passes only along its lobes.
+    Panel(u32),
+}
+
+/// Precomputed light transport for one scene.
+pub struct LightModel {
+    /// The scene the transport was traced in.
+    pub scene: Arc<Scene>,
+    /// The settings it was traced with.
+    pub settings: LightSettings,
+    /// The sky and ground bins daylight coefficients refer to.
+    pub sky_bins: SkyPatches,
+    tracer: Tracer,
+    surfaces: Vec<Surface>,
+    /// The windows by material and outward facing (the one grouping rule).
+    pub windows: WindowGroups,
+    /// Per scene surface: its index in [`Scene::windows`], if it is one.
+    window_of_surface: Vec<Option<u32>>,
+    /// Panel windows by material and orientation, and each surface's group.
+    panel_groups: Vec<panels::PanelGroup>,
+    group_of_surface: Vec<Option<u32>>,
+    /// Per patch side (2 per patch; empty for glass and panels).
+    side_gathers: Vec<Gather>,
+    sensors: Vec<SensorGeometry>,
+}
+
+/// Irradiance (W/m²) on a patch side or sensor, by channel.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Channels {
+    /// All direct sunlight: straight, along panel lobes, and transmitted
+    /// diffusely by panels.
+    pub sun: f64,
+    /// The part of `sun` that panels transmit diffusely (the renderer draws
+    /// it with the patches, not with the sun pass).
+    pub sun_diffuse: f64,
+    /// Sky and ground glow.
+    pub sky: f64,
+    /// Interreflected, RGB.
+    pub indirect: [f64; 3],
+}
+
+impl Channels {
+    /// Photometric indirect irradiance (Radiance's RGB weights).
+    pub fn indirect_luminous(&self) -> f64 {
+        let [r, g, b] = self.indirect;
+        0.265 * r + 0.670 * g + 0.065 * b
+    }
+}
+
+/// A sensor's reading in lux.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SensorReading {
+    /// The sensor's name (grid sensors: `<grid>/<k>`).
+    pub name: String,
+    /// All light: the sum of the three parts, lux.
+    pub total: f64,
+    /// Direct sun, panels' redirected sunlight included, lux.
+    pub direct_sun: f64,
+    /// Direct sky and ground glow, lux.
+    pub direct_sky: f64,
+    /// Interreflected light, lux.
+    pub indirect: f64,
+}
+
+/// The light for one sun and sky.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lighting {
+    /// Per patch side (see [`side_of`]).
+    pub sides: Vec<Channels>,
+    /// Per sensor of the scene, in its order.
+    pub sensors: Vec<SensorReading>,
+    /// Jacobi iterations used.
+    pub iterations: usize,
+    /// The last iteration's largest change of a patch side's indirect light,
+    /// relative to its irradiance (infinite before the first).
+    pub residual: f64,
+}
+
+/// Maps `f` over `0..count` on `threads` threads (all cores when `None`);
+/// the result does not depend on how the work is split.
+pub(crate) fn par_map<T: Send>(threads: Option<usize>, count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let available = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = threads.unwrap_or(available).max(1).min(count.max(1));
+    let chunk = count.div_ceil(threads).max(1);
+    let f = &f;
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..count)
+            .step_by(chunk)
+            .map(|start| scope.spawn(move || (start..(start + chunk).min(count)).map(f).collect::<Vec<T>>()))
+            .collect();
+        handles.into_iter().flat_map(|h| h.join().expect("light worker panicked")).collect()
+    })
+}
+
+impl LightModel {
+    /// The model with its tracer and materials but nothing gathered: enough
+    /// for ray queries ([`Self::trace`], [`Self::sun_irradiance`]), not for
+    /// lighting.
+    pub fn unlit(scene: Arc<Scene>) -> Self {
+        Self::empty(scene, LightSettings::default())
+    }
+
+    /// The first patch a ray meets and its distance.
+    pub fn trace(&self, origin: DVec3, direction: DVec3) -> Option<(u32, f64)> {
+        self.tracer.closest(origin, direction, 1e-6).map(|hit| (hit.patch, hit.distance))
+    }
+
+    /// The model with its tracer and materials but nothing gathered yet.
+    fn empty(scene: Arc<Scene>, settings: LightSettings) -> Self {
+        let tracer = Tracer::new(&scene.patches);
+        let surfaces = scene
+            .materials
+            .iter()
+            .map(|m| match &m.kind {
+                MaterialKind::Diffuse { reflectance } => Surface::Diffuse(reflectance.0.map(f64::from)),
+                MaterialKind::Glass { transmittance } => Surface::Glass(Glass::from_transmittance(f64::from(*transmittance))),
+                // The group is the surface's: see `surface_of_patch`.
+                MaterialKind::Panel { .. } => Surface::Panel(u32::MAX),
+            })
+            .collect();
+        let windows = WindowGroups::new(&scene, &tracer);
+        let (panel_groups, group_of_surface) = panels::panel_groups(&scene, &windows);
+        let mut window_of_surface = vec![None; scene.surfaces.len()];
+        for (k, window) in scene.windows.iter().enumerate() {
+            window_of_surface[window.surface as usize] = Some(k as u32);
+        }
+        Self {
+            sky_bins: SkyPatches::reinhart(settings.sky_subdivision),
+            windows,
+            window_of_surface,
+            panel_groups,
+            group_of_surface,
+            scene,
+            settings,
+            tracer,
+            surfaces,
+            side_gathers: Vec::new(),
+            sensors: Vec::new(),
+        }
+    }
+
+    fn surface_of_patch(&self, patch: u32) -> Surface {
+        let patch = &self.scene.patches.patches[patch as usize];
+        match self.group_of_surface[patch.surface as usize] {
+            Some(group) => Surface::Panel(group),
+            None => self.surfaces[patch.material as usize],
+        }
+    }
+
+    fn patch_normal(&self, patch: u32) -> DVec3 {
+        self.scene.patches.patches[patch as usize].normal.as_dvec3()
+    }
+
+    /// Bins of the sky sphere (sky above the horizon, ground below).
+    fn bin_count(&self) -> u32 {
+        2 * self.sky_bins.len() as u32
+    }
+
+    /// Which panel group a surface's windows belong to.
+    pub fn panel_group_of_surface(&self, surface: u32) -> Option<u32> {
+        self.group_of_surface[surface as usize]
+    }
+
+    /// Sensors that seem to sit inside a solid: every ray from them meets a
+    /// surface from its back, within a few metres. They still read what
+    /// reaches them; the caller warns.
+    pub fn sensors_inside_solids(&self) -> Vec<usize> {
+        const RAYS: usize = 64;
+        let patches = &self.scene.patches.patches;
+        (0..self.scene.sensors.len())
+            .filter(|&i| {
+                let position = self.scene.sensors[i].position.as_dvec3();
+                let mut rng = Rng::new(4, i as u64);
+                let up = cosine_directions(DVec3::Z, RAYS / 2, &mut rng);
+                up.iter().chain(cosine_directions(DVec3::NEG_Z, RAYS / 2, &mut rng).iter()).all(|&d| {
+                    self.tracer
+                        .closest(position, d, 1e-6)
+                        .is_some_and(|hit| hit.distance < 5.0 && d.dot(patches[hit.patch as usize].normal.as_dvec3()) > 0.0)
+                })
+            })
+            .collect()
+    }
+}

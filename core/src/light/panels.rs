@@ -1,0 +1,208 @@
+//! Panel windows in the light engine. Each window group of a panel material
+//! ([`super::windows`]: one material, facing one way) is a panel group with
+//! a frame (its outward normal turned into the room, its `up`), whose
+//! response to the sun is computed once.
+//! Sunlight reaches the room through a panel only along its lobes: each
+//! transmitted lobe is a beam of its own, a fake sun (thesis section 3.5).
+
+use std::sync::{Arc, OnceLock};
+
+use glam::DVec3;
+
+use super::windows::WindowGroups;
+use crate::panel::PanelModel;
+use crate::scene::{MaterialKind, Scene};
+use crate::sky::{SkyPatches, SunSource};
+
+/// A panel's frame in the model: z into the room, y its up, x = y × z.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PanelFrame {
+    /// y × z: across the panel.
+    pub x: DVec3,
+    /// The panel's up, in its plane.
+    pub y: DVec3,
+    /// The window's normal into the room.
+    pub z: DVec3,
+}
+
+impl PanelFrame {
+    /// The frame of a window whose normal into the room is `inward`, with
+    /// `up` projected onto its plane (north for a horizontal window).
+    pub fn new(inward: DVec3, up: Option<DVec3>) -> Self {
+        let z = inward.normalize();
+        let project = |v: DVec3| (v - z * v.dot(z)).try_normalize();
+        let y = up.and_then(project).or_else(|| project(DVec3::Z)).or_else(|| project(DVec3::Y)).unwrap_or(DVec3::X);
+        Self { x: y.cross(z), y, z }
+    }
+
+    /// A model direction in the panel's frame.
+    pub fn to_panel(&self, d: DVec3) -> DVec3 {
+        DVec3::new(d.dot(self.x), d.dot(self.y), d.dot(self.z))
+    }
+
+    /// A panel-frame direction in the model.
+    pub fn to_world(&self, d: DVec3) -> DVec3 {
+        self.x * d.x + self.y * d.y + self.z * d.z
+    }
+}
+
+/// Windows of one panel material facing one way.
+pub struct PanelGroup {
+    /// The panel material (index into [`Scene::materials`]).
+    pub material: u32,
+    /// The material's built panel model.
+    pub model: Arc<dyn PanelModel>,
+    /// The frame shared by the group's windows.
+    pub frame: PanelFrame,
+    /// How sky and ground light pass it, made on first use.
+    transfer: OnceLock<SkyTransfer>,
+}
+
+/// How a panel group passes sky and ground light, per sphere bin the light
+/// comes from: the bins its lobes leave along, as factors from the
+/// incoming bin's radiance to the radiance seen through the panel in the
+/// outgoing bin (share · cos θin · ωin / (cos θout · ωout)), and the factor
+/// to the radiance of its diffuse transmission (τd · cos θin · ωin / π).
+/// The panel is taken to see the sky and ground unobstructed.
+pub struct SkyTransfer {
+    /// Per incoming bin: (outgoing bin, radiance factor) for each transmitted lobe.
+    pub lobes: Vec<Vec<(u32, f64)>>,
+    /// Per incoming bin: the factor to the diffusely transmitted radiance.
+    pub diffuse: Vec<f64>,
+}
+
+impl PanelGroup {
+    /// The group's sky transfer over `bins`' sphere bins.
+    pub fn sky_transfer(&self, bins: &SkyPatches) -> &SkyTransfer {
+        self.transfer.get_or_init(|| {
+            let count = 2 * bins.len();
+            let direction = |b: usize| {
+                let d = bins.patches[b % bins.len()].direction;
+                if b < bins.len() { d } else { DVec3::new(d.x, d.y, -d.z) }
+            };
+            let solid_angle = |b: usize| bins.patches[b % bins.len()].solid_angle;
+            // Each bin on its own (panel responses can be costly): in parallel.
+            let per_bin = super::par_map(None, count, |b| {
+                // Light from bin b travels away from it.
+                let incoming = self.frame.to_panel(-direction(b));
+                if incoming.z <= 0.0 {
+                    return (Vec::new(), 0.0);
+                }
+                let flux = incoming.z * solid_angle(b);
+                let response = self.model.response(incoming);
+                let lobes = response
+                    .lobes
+                    .iter()
+                    .filter(|l| l.direction.z > 1e-6 && l.share > 0.0)
+                    .map(|lobe| {
+                        // Seen from the room, looking back against the lobe.
+                        let out = bins.sphere_bin(-self.frame.to_world(lobe.direction));
+                        (out as u32, lobe.share * flux / (lobe.direction.z * solid_angle(out)))
+                    })
+                    .collect();
+                (lobes, response.diffuse_transmittance * flux / std::f64::consts::PI)
+            });
+            let (lobes, diffuse) = per_bin.into_iter().unzip();
+            SkyTransfer { lobes, diffuse }
+        })
+    }
+
+    /// Radiance (W/sr/m²) of sky and ground light seen through the group's
+    /// windows in every sphere bin, for bin radiances `sky`.
+    pub fn radiance_through(&self, bins: &SkyPatches, sky: &[f64]) -> Vec<f64> {
+        let transfer = self.sky_transfer(bins);
+        let mut out = vec![0.0; sky.len()];
+        let mut diffuse = 0.0;
+        for (b, &radiance) in sky.iter().enumerate() {
+            if radiance <= 0.0 {
+                continue;
+            }
+            for &(o, factor) in &transfer.lobes[b] {
+                out[o as usize] += factor * radiance;
+            }
+            diffuse += transfer.diffuse[b] * radiance;
+        }
+        out.iter_mut().for_each(|r| *r += diffuse);
+        out
+    }
+
+    /// Radiance (W/sr/m²) of the sunlight the group's windows transmit
+    /// diffusely (their lobes are beams of their own): sunlight redirected
+    /// by the panel, so it counts as direct sun.
+    pub fn sun_diffuse_radiance(&self, sun: Option<&SunSource>) -> f64 {
+        let Some(sun) = sun.filter(|s| s.direction.z > 0.0) else { return 0.0 };
+        let incoming = self.frame.to_panel(-sun.direction);
+        if incoming.z <= 0.0 {
+            return 0.0;
+        }
+        sun.normal_irradiance() * incoming.z * self.model.response(incoming).diffuse_transmittance / std::f64::consts::PI
+    }
+}
+
+/// A beam of direct sunlight: the sun itself, or a panel lobe's fake sun.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SunBeam {
+    /// Unit vector toward the (fake) sun.
+    pub to_light: DVec3,
+    /// Irradiance normal to the beam, W/m² (for a lobe: after the panel).
+    pub normal_irradiance: f64,
+    /// The panel group the beam comes out of; `None` for the sun itself.
+    pub panel_group: Option<u32>,
+}
+
+/// The panel groups of a scene (one per window group of a panel material,
+/// see [`super::windows`]) and each surface's group.
+pub fn panel_groups(scene: &Scene, windows: &WindowGroups) -> (Vec<PanelGroup>, Vec<Option<u32>>) {
+    let mut groups: Vec<PanelGroup> = Vec::new();
+    let mut group_of_surface = vec![None; scene.surfaces.len()];
+    for window_group in &windows.groups {
+        let MaterialKind::Panel { model, up, .. } = &scene.materials[window_group.material as usize].kind else { continue };
+        let frame = PanelFrame::new(-window_group.outward, up.map(|u| u.as_dvec3()));
+        for &window in &window_group.windows {
+            group_of_surface[scene.windows[window as usize].surface as usize] = Some(groups.len() as u32);
+        }
+        groups.push(PanelGroup { material: window_group.material, model: model.0.clone(), frame, transfer: OnceLock::new() });
+    }
+    (groups, group_of_surface)
+}
+
+/// The beams of direct sunlight for a sun: the sun, and for each panel
+/// group its transmitted lobes. A lobe carries the flux the panel's area
+/// receives (E · cos θin) times its share, spread over the beam's cross
+/// section (÷ cos θout).
+pub fn sun_beams(groups: &[PanelGroup], sun: &SunSource) -> Vec<SunBeam> {
+    let mut beams = vec![SunBeam { to_light: sun.direction, normal_irradiance: sun.normal_irradiance(), panel_group: None }];
+    for (index, group) in groups.iter().enumerate() {
+        let incoming = group.frame.to_panel(-sun.direction);
+        if incoming.z <= 0.0 {
+            continue;
+        }
+        for lobe in group.model.response(incoming).lobes.iter().filter(|l| l.direction.z > 1e-6 && l.share > 0.0) {
+            let out = group.frame.to_world(lobe.direction).normalize();
+            beams.push(SunBeam {
+                to_light: -out,
+                normal_irradiance: sun.normal_irradiance() * incoming.z * lobe.share / lobe.direction.z,
+                panel_group: Some(index as u32),
+            });
+        }
+    }
+    beams
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frames_are_right_handed_with_up_in_the_plane() {
+        // A south wall seen from the room: into the room is north (+y).
+        let frame = PanelFrame::new(DVec3::Y, None);
+        assert!((frame.y - DVec3::Z).length() < 1e-12);
+        assert!((frame.x.cross(frame.y) - frame.z).length() < 1e-12);
+        // A skylight: up is north.
+        let frame = PanelFrame::new(-DVec3::Z, None);
+        assert!((frame.y - DVec3::Y).length() < 1e-12);
+        let d = DVec3::new(0.3, -0.4, 0.866).normalize();
+        assert!((frame.to_world(frame.to_panel(d)) - d).length() < 1e-12);
+    }
+}

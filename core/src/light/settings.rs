@@ -1,0 +1,63 @@
+//! The light engine's knobs ([`LightSettings`]): rays, sky subdivision,
+//! iteration budget. The defaults reach the accuracy targets.
+
+/// Knobs of the simulation; the defaults reach the accuracy targets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightSettings {
+    /// Hemisphere rays from each side of each patch (form factors, sky coefficients).
+    pub rays_per_patch: usize,
+    /// Hemisphere rays from each sensor point.
+    pub rays_per_sensor: usize,
+    /// Shadow rays toward the sun per patch.
+    pub sun_samples_per_patch: usize,
+    /// Points per side of an area sensor's grid for the direct sun (sky and
+    /// indirect use a 4 × 4 grid).
+    pub area_sensor_sun_grid: usize,
+    /// Reinhart MF:n of the sky bins.
+    pub sky_subdivision: u32,
+    /// Jacobi iterations at most.
+    pub max_iterations: usize,
+    /// Stop when no patch side's indirect irradiance changes by more than
+    /// this fraction of its own irradiance in an iteration.
+    pub tolerance: f64,
+    /// Worker threads; `None` for all cores. Results do not depend on it.
+    pub threads: Option<usize>,
+}
+
+impl Default for LightSettings {
+    fn default() -> Self {
+        Self {
+            rays_per_patch: 256,
+            rays_per_sensor: 4096,
+            sun_samples_per_patch: 16,
+            area_sensor_sun_grid: 32,
+            sky_subdivision: 4,
+            max_iterations: 200,
+            tolerance: 1e-4,
+            threads: None,
+        }
+    }
+}
+
+impl LightSettings {
+    /// One line naming the first setting that cannot work.
+    pub fn check(&self) -> Result<(), String> {
+        let positive = [
+            (self.rays_per_patch, "rays_per_patch"),
+            (self.rays_per_sensor, "rays_per_sensor"),
+            (self.sun_samples_per_patch, "sun_samples_per_patch"),
+            (self.area_sensor_sun_grid, "area_sensor_sun_grid"),
+            (self.max_iterations, "max_iterations"),
+        ];
+        if let Some((_, name)) = positive.iter().find(|(v, _)| *v == 0) {
+            return Err(format!("lighting setting {name} must be at least 1"));
+        }
+        if self.sky_subdivision == 0 || self.sky_subdivision > 16 {
+            return Err(format!("sky subdivision MF:{} is outside 1-16", self.sky_subdivision));
+        }
+        if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
+            return Err(format!("tolerance {} must lie in (0, 1)", self.tolerance));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,297 @@
+//! Scene loading: a scene file (TOML) with its OBJ and MTL turned into the
+//! geometry, materials, windows, patches and sensors every other part of
+//! heliodon works on. Plain Rust, no Bevy types: the Bevy asset loader, the
+//! CLI and the tests all go through [`load_scene_with`].
+//!
+//! Everything is in one canonical frame: metres, x east, y north, z up (as in
+//! Radiance). [`ModelFrame`] maps the model's own axes, north and units into it.
+
+mod error;
+mod file;
+mod frame;
+mod material;
+mod obj;
+mod patches;
+pub(crate) use patches::clip as clip_convex;
+mod sensors;
+mod surfaces;
+
+use std::future::Future;
+use std::io;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+pub use error::{Location, SceneError, SceneWarning, line_of};
+pub use frame::{ModelFrame, UpAxis};
+pub use material::{Material, MaterialKind, MaterialOrigin, Rgb};
+pub use patches::{Patch, PatchMesh};
+pub use sensors::{DEFAULT_FOV, Sensor, Viewpoint};
+
+use crate::panel::PanelCatalog;
+use crate::site::Site;
+
+/// Default side of the largest lighting patch, in metres.
+pub const DEFAULT_PATCH_SIZE: f32 = 0.5;
+
+/// A loaded scene in the canonical frame (metres, x east, y north, z up).
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// The scene file's `name`, or its file name without the extension.
+    pub name: String,
+    /// The files it was read from.
+    pub files: SceneFiles,
+    /// Where it stands: coordinates, timezone, ground reflectance.
+    pub site: Site,
+    /// How the model's coordinates map into the canonical frame.
+    pub frame: ModelFrame,
+    /// Side (metres) of the square the largest lighting patch fits in: the
+    /// scene file's `[lighting] patch_size`, [`DEFAULT_PATCH_SIZE`] when absent.
+    pub patch_size: f32,
+    /// Every material a face uses; triangles, surfaces, patches and windows
+    /// index into it.
+    pub materials: Vec<Material>,
+    /// The model's triangles after the frame mapping, degenerate ones dropped,
+    /// ordered by surface.
+    pub triangles: Vec<Triangle>,
+    /// Connected planar pieces of one material, in the order of their
+    /// triangles.
+    pub surfaces: Vec<Surface>,
+    /// The surfaces of transmitting materials (glass and panels).
+    pub windows: Vec<Window>,
+    /// The lighting patches the surfaces are cut into, with their render
+    /// triangles.
+    pub patches: PatchMesh,
+    /// Illuminance sensors, grids expanded to their points.
+    pub sensors: Vec<Sensor>,
+    /// Named camera positions (`[[cameras]]`).
+    pub viewpoints: Vec<Viewpoint>,
+    /// Axis-aligned bounds of all triangles: (min, max).
+    pub bounds: (Vec3, Vec3),
+}
+
+/// The files a scene was read from, as the user would name them.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct SceneFiles {
+    /// The scene file (TOML).
+    pub scene: PathBuf,
+    /// The OBJ model: the scene file's `model.obj`, resolved against its folder.
+    pub obj: PathBuf,
+    /// The MTL libraries the OBJ names (`mtllib`), resolved against its folder.
+    pub mtls: Vec<PathBuf>,
+}
+
+/// One triangle of the model, single-sided as in Radiance (both sides reflect).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Triangle {
+    /// Corners in the canonical frame; their winding gives the normal.
+    pub vertices: [Vec3; 3],
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+}
+
+impl Triangle {
+    /// Twice the area times the unit normal (counter-clockwise winding).
+    pub fn cross(&self) -> Vec3 {
+        let [a, b, c] = self.vertices;
+        (b - a).cross(c - a)
+    }
+
+    /// Area, m².
+    pub fn area(&self) -> f32 {
+        0.5 * self.cross().length()
+    }
+
+    /// Unit normal (counter-clockwise winding); zero for a degenerate triangle.
+    pub fn normal(&self) -> Vec3 {
+        self.cross().normalize_or_zero()
+    }
+
+    /// The mean of the three corners.
+    pub fn centroid(&self) -> Vec3 {
+        let [a, b, c] = self.vertices;
+        (a + b + c) / 3.0
+    }
+}
+
+/// A connected, planar group of triangles of one material: a wall, a desk top,
+/// a window pane. Patches subdivide surfaces.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Surface {
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+    /// Range into [`Scene::triangles`].
+    pub triangles: Range<u32>,
+    /// Range into [`PatchMesh::patches`].
+    pub patches: Range<u32>,
+    /// Area-weighted unit normal.
+    pub normal: Vec3,
+    /// Sum of its triangles' areas, m².
+    pub area: f32,
+}
+
+/// An aperture: a surface of a transmitting material (glass or panel).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Window {
+    /// Index into [`Scene::surfaces`].
+    pub surface: u32,
+    /// Index into [`Scene::materials`]: a glass or a panel.
+    pub material: u32,
+    /// Glazed area, m².
+    pub area: f32,
+    /// The surface's area-weighted unit normal.
+    pub normal: Vec3,
+    /// Area-weighted centroid of its triangles.
+    pub centroid: Vec3,
+}
+
+/// A scene and what the user should hear about it.
+#[derive(Debug, Clone)]
+pub struct LoadedScene {
+    /// The scene, loaded.
+    pub scene: Scene,
+    /// What did not stop the load (unused materials, dropped degenerate
+    /// triangles), to show the user.
+    pub warnings: Vec<SceneWarning>,
+}
+
+/// Reads the files a scene refers to. The loader stays independent of where
+/// bytes come from: the file system for the CLI, Bevy's asset readers in apps.
+pub trait SceneReader {
+    /// The whole content of the file at `path`.
+    fn read(&mut self, path: &Path) -> impl Future<Output = io::Result<Vec<u8>>>;
+}
+
+/// Reads straight from the file system.
+pub struct FsReader;
+
+impl SceneReader for FsReader {
+    async fn read(&mut self, path: &Path) -> io::Result<Vec<u8>> {
+        std::fs::read(path)
+    }
+}
+
+/// Loads a scene file from disk; panel materials are built by the types in
+/// `panels`.
+pub fn load_scene(path: &Path, panels: &PanelCatalog) -> Result<LoadedScene, SceneError> {
+    futures_lite::future::block_on(load_scene_with(path, panels, &mut FsReader))
+}
+
+/// Loads a scene file and everything it refers to through `reader`.
+pub async fn load_scene_with(scene_path: &Path, panels: &PanelCatalog, reader: &mut impl SceneReader) -> Result<LoadedScene, SceneError> {
+    let scene_text = read_text(reader, scene_path, None).await?;
+    let parsed = file::parse(scene_path, &scene_text)?;
+    let obj_path = parsed.obj_path();
+    let obj_text = read_text(reader, &obj_path, Some(parsed.obj_location())).await?;
+    let obj_scan = obj::scan(&obj_path, &obj_text)?;
+    let mut mtls = Vec::new();
+    for library in &obj_scan.material_libraries {
+        let path = obj_path.parent().unwrap_or(Path::new("")).join(&library.name);
+        let location = Location::line(&obj_path, library.line);
+        let text = read_text(reader, &path, Some(location)).await?;
+        mtls.push((path, text));
+    }
+    build(parsed, obj_path, &obj_text, obj_scan, mtls, panels)
+}
+
+async fn read_text(reader: &mut impl SceneReader, path: &Path, referenced_at: Option<Location>) -> Result<String, SceneError> {
+    let bytes = reader.read(path).await.map_err(|error| {
+        let what = match error.kind() {
+            io::ErrorKind::NotFound => "not found".to_string(),
+            _ => error.to_string(),
+        };
+        match referenced_at {
+            Some(location) => SceneError::new(location, format!("cannot read '{}': {what}", path.display())),
+            None => SceneError::new(Location::file(path), format!("cannot read scene file: {what}")),
+        }
+    })?;
+    String::from_utf8(bytes).map_err(|_| SceneError::new(Location::file(path), "not UTF-8 text"))
+}
+
+fn build(
+    parsed: file::ParsedScene,
+    obj_path: PathBuf,
+    obj_text: &str,
+    obj_scan: obj::ObjScan,
+    mtls: Vec<(PathBuf, String)>,
+    panels: &PanelCatalog,
+) -> Result<LoadedScene, SceneError> {
+    let mut warnings = Vec::new();
+    let model = obj::import(&obj_path, obj_text, &obj_scan, &mtls)?;
+    let (materials, material_of) = material::resolve(&parsed, &model, panels, &obj_path, &mut warnings)?;
+    let raw_triangles = obj::triangles(&model, &parsed.frame, &material_of, &obj_path, &mut warnings)?;
+    let (triangles, mut surfaces) = surfaces::group(raw_triangles);
+    let patches = patches::subdivide(&triangles, &mut surfaces, parsed.patch_size);
+    let windows = surfaces::windows(&triangles, &surfaces, &materials);
+    let sensors = sensors::sensors(&parsed)?;
+    let viewpoints = sensors::viewpoints(&parsed)?;
+    let bounds = bounds(&triangles);
+    Ok(LoadedScene {
+        scene: Scene {
+            name: parsed.name.clone(),
+            files: SceneFiles { scene: parsed.path.clone(), obj: obj_path, mtls: mtls.into_iter().map(|(path, _)| path).collect() },
+            site: parsed.site,
+            frame: parsed.frame,
+            patch_size: parsed.patch_size,
+            materials,
+            triangles,
+            surfaces,
+            windows,
+            patches,
+            sensors,
+            viewpoints,
+            bounds,
+        },
+        warnings,
+    })
+}
+
+fn bounds(triangles: &[Triangle]) -> (Vec3, Vec3) {
+    triangles
+        .iter()
+        .flat_map(|t| t.vertices)
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), v| (lo.min(v), hi.max(v)))
+}
+
+impl Scene {
+    /// The material of index `id`, as triangles, surfaces, patches and windows
+    /// hold it.
+    pub fn material(&self, id: u32) -> &Material {
+        &self.materials[id as usize]
+    }
+
+    /// Total glazed area of all windows (m²), for summaries.
+    pub fn window_area(&self) -> f32 {
+        self.windows.iter().map(|w| w.area).sum()
+    }
+
+    /// Gives `surfaces` (say, the windows of one façade) a material of their
+    /// own: a copy of the one the first of them has, named `name`, so it can
+    /// be changed without touching the others that shared it. Their
+    /// triangles, patches and windows follow. Returns the new material's
+    /// index; `None` when `surfaces` is empty, out of range or of more than
+    /// one material.
+    pub fn give_own_material(&mut self, surfaces: &[u32], name: String) -> Option<u32> {
+        let material = self.surfaces.get(*surfaces.first()? as usize)?.material;
+        if surfaces.iter().any(|&s| self.surfaces.get(s as usize).is_none_or(|s| s.material != material)) {
+            return None;
+        }
+        let new = self.materials.len() as u32;
+        self.materials.push(Material { name, ..self.materials[material as usize].clone() });
+        for &index in surfaces {
+            let surface = &mut self.surfaces[index as usize];
+            surface.material = new;
+            for triangle in &mut self.triangles[surface.triangles.start as usize..surface.triangles.end as usize] {
+                triangle.material = new;
+            }
+            for patch in &mut self.patches.patches[surface.patches.start as usize..surface.patches.end as usize] {
+                patch.material = new;
+            }
+        }
+        for window in self.windows.iter_mut().filter(|w| surfaces.contains(&w.surface)) {
+            window.material = new;
+        }
+        Some(new)
+    }
+}

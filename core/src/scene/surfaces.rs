@@ -1,0 +1,122 @@
+//! Surfaces: the model's triangles grouped into connected planar pieces of one
+//! material (a wall, a desk top, a window pane), and the windows among them.
+
+use std::collections::HashMap;
+
+use glam::Vec3;
+
+use super::material::Material;
+use super::{Surface, Triangle, Window};
+
+/// Positions closer than this (metres) are the same vertex when finding
+/// shared edges.
+const WELD: f32 = 1e-4;
+/// Neighbouring triangles whose normals differ by less than about 1.5° lie in
+/// one surface.
+const COPLANAR_COS: f32 = 0.99966;
+
+/// Groups triangles into surfaces; returns the triangles reordered so that
+/// each surface's triangles are contiguous, and the surfaces (patch ranges
+/// still empty). The order is deterministic: surfaces by their first triangle.
+pub fn group(triangles: Vec<Triangle>) -> (Vec<Triangle>, Vec<Surface>) {
+    let normals: Vec<Vec3> = triangles.iter().map(Triangle::normal).collect();
+    let mut sets = DisjointSets::new(triangles.len());
+    let mut edges: HashMap<([i64; 3], [i64; 3]), Vec<u32>> = HashMap::new();
+    for (t, triangle) in triangles.iter().enumerate() {
+        let keys = triangle.vertices.map(weld_key);
+        for (a, b) in [(keys[0], keys[1]), (keys[1], keys[2]), (keys[2], keys[0])] {
+            let edge = if a <= b { (a, b) } else { (b, a) };
+            edges.entry(edge).or_default().push(t as u32);
+        }
+    }
+    // HashMap order does not matter: unions give the same partition in any order.
+    for sharing in edges.values() {
+        for (i, &a) in sharing.iter().enumerate() {
+            for &b in &sharing[i + 1..] {
+                let (ta, tb) = (&triangles[a as usize], &triangles[b as usize]);
+                if ta.material == tb.material && normals[a as usize].dot(normals[b as usize]) >= COPLANAR_COS {
+                    sets.union(a, b);
+                }
+            }
+        }
+    }
+    let mut surface_of_root: HashMap<u32, u32> = HashMap::new();
+    let mut members: Vec<Vec<u32>> = Vec::new();
+    for t in 0..triangles.len() as u32 {
+        let root = sets.find(t);
+        let surface = *surface_of_root.entry(root).or_insert_with(|| {
+            members.push(Vec::new());
+            members.len() as u32 - 1
+        });
+        members[surface as usize].push(t);
+    }
+    let mut ordered = Vec::with_capacity(triangles.len());
+    let mut surfaces = Vec::with_capacity(members.len());
+    for group in members {
+        let start = ordered.len() as u32;
+        let mut weighted_normal = Vec3::ZERO;
+        let mut area = 0.0;
+        for &t in &group {
+            let triangle = triangles[t as usize];
+            weighted_normal += triangle.cross();
+            area += triangle.area();
+            ordered.push(triangle);
+        }
+        surfaces.push(Surface {
+            material: triangles[group[0] as usize].material,
+            triangles: start..ordered.len() as u32,
+            patches: 0..0,
+            normal: weighted_normal.normalize_or_zero(),
+            area,
+        });
+    }
+    (ordered, surfaces)
+}
+
+/// The surfaces of transmitting materials, as apertures.
+pub fn windows(triangles: &[Triangle], surfaces: &[Surface], materials: &[Material]) -> Vec<Window> {
+    surfaces
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| materials[s.material as usize].kind.transmits())
+        .map(|(index, surface)| {
+            let tris = &triangles[surface.triangles.start as usize..surface.triangles.end as usize];
+            let centroid = tris.iter().map(|t| t.centroid() * t.area()).sum::<Vec3>() / surface.area;
+            Window { surface: index as u32, material: surface.material, area: surface.area, normal: surface.normal, centroid }
+        })
+        .collect()
+}
+
+fn weld_key(p: Vec3) -> [i64; 3] {
+    (p / WELD).round().as_i64vec3().to_array()
+}
+
+/// Union-find with path halving.
+struct DisjointSets {
+    parent: Vec<u32>,
+}
+
+impl DisjointSets {
+    fn new(n: usize) -> Self {
+        Self { parent: (0..n as u32).collect() }
+    }
+
+    fn find(&mut self, mut x: u32) -> u32 {
+        while self.parent[x as usize] != x {
+            let grandparent = self.parent[self.parent[x as usize] as usize];
+            self.parent[x as usize] = grandparent;
+            x = grandparent;
+        }
+        x
+    }
+
+    /// Joins two sets; the smaller root becomes the root, so roots (and with
+    /// them the surface order) do not depend on the order of unions.
+    fn union(&mut self, a: u32, b: u32) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+            self.parent[hi as usize] = lo;
+        }
+    }
+}

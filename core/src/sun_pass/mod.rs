@@ -1,0 +1,265 @@
+//! The sun pass's main-world geometry: what the stencil shadow-volume pass
+//! draws for one scene, sun and panel state ([`SunPassFrame`]), as plain
+//! data for the renderer to upload. The algorithm (the thesis' algorithm 1)
+//! and the GPU side are described in the renderer's `render::sun_pass`.
+//!
+//! - [`shadow_volume`]: per-triangle volumes for a directional light,
+//!   silhouette edges only where the casters are manifold;
+//! - [`SunPassFrame::new`]: one [`DirectionPass`] per light direction (the
+//!   sun, then every panel lobe as a fake sun), its opaque casters' volume
+//!   and its lights through apertures (glass windows of one material facing
+//!   one way, or a panel group's windows);
+//! - [`lit_vertices`]: the diffuse surfaces the lit passes draw.
+
+mod shadow_volume;
+
+use std::ops::Range;
+use std::sync::Arc;
+
+use glam::{Vec3, Vec4};
+
+pub use shadow_volume::{ShadowVolume, shadow_volume};
+
+use crate::light::{Glass, LightModel};
+use crate::scene::{MaterialKind, Scene, clip_convex};
+use crate::sky::SunSource;
+
+/// A light along a pass's direction and the aperture it comes through.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SunLight {
+    /// Unit vector toward the light (the sun, or a lobe's fake sun).
+    pub direction: Vec3,
+    /// Irradiance normal to `direction` after the window, W/m².
+    pub irradiance: f32,
+    /// The aperture's volume (range in [`SunPassFrame::volumes`]); `None`:
+    /// light that meets no surface at all (the outside of the model), with
+    /// every window's volume counted as blocking.
+    pub aperture: Option<Range<u32>>,
+}
+
+/// Everything drawn for one light direction: the opaque casters' volume
+/// along it, then its lights.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DirectionPass {
+    /// The opaque casters' near caps (range in [`SunPassFrame::volumes`]), drawn depth-biased.
+    pub opaque_caps: Range<u32>,
+    /// The opaque casters' side triangles (and the shadows exterior casters throw on a panel).
+    pub opaque_sides: Range<u32>,
+    /// Every window's volume along this direction (for the outside light).
+    pub all_windows: Range<u32>,
+    /// The lights along this direction, each through its aperture.
+    pub lights: Vec<SunLight>,
+}
+
+/// What the sun pass draws for the current scene, sun and mode.
+pub struct SunPassFrame {
+    /// Counts changes, so the render world uploads each frame only once.
+    pub generation: u64,
+    /// Lit surfaces as interleaved position, normal, albedo (9 floats per vertex).
+    pub lit: Arc<Vec<f32>>,
+    /// All shadow volumes, referred to by ranges.
+    pub volumes: Vec<Vec4>,
+    /// The sun's direction first, then each panel lobe's.
+    pub passes: Vec<DirectionPass>,
+}
+
+impl SunPassFrame {
+    /// The passes for `scene` under `sun`, sharing `lit` (see
+    /// [`lit_vertices`]); `model` knows the panel windows and their lobes.
+    /// The sun's pass lights through glass (Radiance's transmittance at each
+    /// aperture's angle) and the outside; each panel lobe is a fake sun with
+    /// a pass of its own through its panel's windows (the thesis' 1 + 2·k·d
+    /// passes). What shades a panel from the real sun outside is projected
+    /// onto the panel and casts along each of its lobes, as in the engine.
+    pub fn new(scene: &Scene, model: &LightModel, lit: Arc<Vec<f32>>, sun: &SunSource, generation: u64) -> Self {
+        let surface_triangles = |surface: u32| {
+            let range = scene.surfaces[surface as usize].triangles.clone();
+            scene.triangles[range.start as usize..range.end as usize].iter().map(|t| t.vertices)
+        };
+        let opaque_casters: Vec<[Vec3; 3]> = scene
+            .triangles
+            .iter()
+            .filter(|t| matches!(scene.materials[t.material as usize].kind, MaterialKind::Diffuse { .. }))
+            .map(|t| t.vertices)
+            .collect();
+        // Apertures: the window groups (one material facing one way, see
+        // `light::windows`), glass passing the sun alike, panels by their lobes.
+        enum Key {
+            Glass(u32),
+            Panel(u32),
+        }
+        let apertures: Vec<(Key, Vec<[Vec3; 3]>, Vec3)> = model
+            .windows
+            .groups
+            .iter()
+            .map(|group| {
+                let surfaces = group.windows.iter().map(|&w| scene.windows[w as usize].surface);
+                let panes = surfaces.clone().flat_map(surface_triangles).collect();
+                let first = surfaces.clone().next().expect("a group has a window");
+                let key = match model.panel_group_of_surface(first) {
+                    Some(panel_group) => Key::Panel(panel_group),
+                    None => Key::Glass(group.material),
+                };
+                (key, panes, group.outward.as_vec3())
+            })
+            .collect();
+        let mut volumes: Vec<Vec4> = Vec::new();
+        let add_volume = |casters: &[[Vec3; 3]], direction: Vec3, volumes: &mut Vec<Vec4>| {
+            let volume = shadow_volume(casters, direction);
+            let start = volumes.len() as u32;
+            let caps = start..start + volume.caps.len() as u32;
+            volumes.extend(volume.caps);
+            volumes.extend(volume.sides);
+            (caps.clone(), caps.end..volumes.len() as u32)
+        };
+        let direction_pass = |casters: &[[Vec3; 3]], direction: Vec3, volumes: &mut Vec<Vec4>| {
+            let (opaque_caps, opaque_sides) = add_volume(casters, direction, volumes);
+            DirectionPass { opaque_caps, opaque_sides, all_windows: 0..0, lights: Vec::new() }
+        };
+        let to_sun = sun.direction.as_vec3();
+        let mut sun_pass = direction_pass(&opaque_casters, to_sun, &mut volumes);
+        let windows_start = volumes.len() as u32;
+        let mut aperture_volumes = Vec::new();
+        for (_, panes, _) in &apertures {
+            let (caps, sides) = add_volume(panes, to_sun, &mut volumes);
+            aperture_volumes.push(caps.start..sides.end);
+        }
+        sun_pass.all_windows = windows_start..volumes.len() as u32;
+        let beams = model.sun_beams(sun);
+        let mut lobe_passes = Vec::new();
+        for ((key, panes, normal), volume) in apertures.iter().zip(aperture_volumes) {
+            match key {
+                Key::Glass(material) => {
+                    let cos = f64::from(normal.dot(to_sun));
+                    let transmittance = match &scene.materials[*material as usize].kind {
+                        MaterialKind::Glass { transmittance } => Glass::from_transmittance(f64::from(*transmittance)).at(cos).0,
+                        _ => 1.0,
+                    };
+                    if cos.abs() > 1e-6 {
+                        let irradiance = (sun.normal_irradiance() * transmittance) as f32;
+                        sun_pass.lights.push(SunLight { direction: to_sun, irradiance, aperture: Some(volume) });
+                    }
+                }
+                Key::Panel(group) => {
+                    // What shades the panel from the real sun outside casts
+                    // along each lobe too, from where it lies on the panel.
+                    let shadows = shadows_on(panes, *normal, &opaque_casters, to_sun);
+                    // A lobe's light starts at the panel: only what lies on
+                    // the room side of it casts along the lobe.
+                    let inside = normal * -to_sun.dot(*normal).signum();
+                    let inner_casters = beside(&opaque_casters, panes[0][0], inside);
+                    for beam in beams.iter().filter(|b| b.panel_group == Some(*group)) {
+                        let direction = beam.to_light.as_vec3();
+                        let mut pass = direction_pass(&inner_casters, direction, &mut volumes);
+                        let (_, shadow_sides) = add_volume(&shadows, direction, &mut volumes);
+                        pass.opaque_sides.end = shadow_sides.end;
+                        let (caps, sides) = add_volume(panes, direction, &mut volumes);
+                        pass.lights.push(SunLight {
+                            direction,
+                            irradiance: beam.normal_irradiance as f32,
+                            aperture: Some(caps.start..sides.end),
+                        });
+                        lobe_passes.push(pass);
+                    }
+                }
+            }
+        }
+        sun_pass.lights.push(SunLight { direction: to_sun, irradiance: sun.normal_irradiance() as f32, aperture: None });
+        let mut passes = vec![sun_pass];
+        passes.extend(lobe_passes);
+        Self { generation, lit, volumes, passes }
+    }
+
+    /// The lights of all passes in order (one uniform each).
+    pub fn lights(&self) -> impl Iterator<Item = &SunLight> {
+        self.passes.iter().flat_map(|p| &p.lights)
+    }
+
+    /// Draw calls per frame: per pass the opaque caps and sides, per light
+    /// through an aperture its volume twice and the lit surfaces, for the
+    /// outside light the windows' volumes and the lit surfaces; plus the
+    /// depth copy.
+    pub fn draw_count(&self) -> usize {
+        1 + self.passes.iter().map(|p| 2 + p.lights.iter().map(|l| if l.aperture.is_some() { 3 } else { 2 }).sum::<usize>()).sum::<usize>()
+    }
+}
+
+/// The shadows `casters` throw on a window's `panes` (a plane with
+/// `normal`) under the sun along `to_sun`: each caster between the window
+/// and the sun, projected along the sun onto the window's plane and clipped
+/// to each pane (panes are triangles, hence convex). As casters along a
+/// lobe, they keep its light from the shaded part of the panel.
+fn shadows_on(panes: &[[Vec3; 3]], normal: Vec3, casters: &[[Vec3; 3]], to_sun: Vec3) -> Vec<[Vec3; 3]> {
+    let Some(origin) = panes.first().map(|p| p[0]) else { return Vec::new() };
+    let toward = to_sun.dot(normal);
+    if toward.abs() < 1e-6 {
+        return Vec::new();
+    }
+    // The sun's side of the plane: `above` along `side`.
+    let side = normal * toward.signum();
+    let (lo, hi) = panes.iter().flatten().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let mut out = Vec::new();
+    for in_front in beside(casters, origin, side) {
+        // Along the sun onto the plane.
+        let projected: Vec<Vec3> = in_front.iter().map(|&p| p - to_sun * ((p - origin).dot(normal) / toward)).collect();
+        let (plo, phi) = projected.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        if plo.cmpgt(hi + 1e-4).any() || phi.cmplt(lo - 1e-4).any() {
+            continue;
+        }
+        for pane in panes {
+            // Inside a pane: on the inner side of each of its edges' planes.
+            let pane_normal = (pane[1] - pane[0]).cross(pane[2] - pane[0]);
+            let mut polygon = projected.clone();
+            for k in 0..3 {
+                let (a, b) = (pane[k], pane[(k + 1) % 3]);
+                let inward = pane_normal.cross(b - a);
+                polygon = clip_convex(&polygon, inward, a.dot(inward), true);
+                if polygon.len() < 3 {
+                    break;
+                }
+            }
+            for k in 1..polygon.len().saturating_sub(1) {
+                out.push([polygon[0], polygon[k], polygon[k + 1]]);
+            }
+        }
+    }
+    out
+}
+
+/// The parts of `casters` strictly on the `side` of the plane through
+/// `origin` (as triangles).
+fn beside(casters: &[[Vec3; 3]], origin: Vec3, side: Vec3) -> Vec<[Vec3; 3]> {
+    let mut out = Vec::new();
+    for caster in casters {
+        let polygon = clip_convex(&caster[..], side, origin.dot(side) + 1e-4, true);
+        for k in 1..polygon.len().saturating_sub(1) {
+            out.push([polygon[0], polygon[k], polygon[k + 1]]);
+        }
+    }
+    out
+}
+
+/// The diffuse surfaces as the sun pass draws them: the very triangles of
+/// the patch meshes the main pass drew, so their depths match exactly.
+/// A face the model holds twice is drawn once (light is added, so a
+/// duplicate would double it).
+pub fn lit_vertices(scene: &Scene) -> Vec<f32> {
+    let mut out = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    for patch in &scene.patches.patches {
+        let MaterialKind::Diffuse { reflectance } = &scene.materials[patch.material as usize].kind else { continue };
+        for triangle in &scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize] {
+            let mut key = triangle.map(|v| v.to_array().map(f32::to_bits));
+            key.sort_unstable();
+            if !seen.insert(key) {
+                continue;
+            }
+            for v in triangle {
+                out.extend(v.to_array());
+                out.extend(patch.normal.to_array());
+                out.extend(reflectance.0);
+            }
+        }
+    }
+    out
+}

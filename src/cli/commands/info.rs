@@ -1,0 +1,128 @@
+//! `heliodon info`: a summary of a scene (loading, and the rays that tell
+//! which side of each window is outside; no light).
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::sync::Arc;
+
+use crate::cli::CliError;
+use crate::light::{LightModel, WindowGroups};
+use crate::panel::PanelCatalog;
+use crate::scene::{self, MaterialKind, Scene};
+
+/// Prints the summary of the scene file at `path`.
+pub fn run(path: &Path, panels: &PanelCatalog) -> Result<(), CliError> {
+    let loaded = scene::load_scene(path, panels).map_err(|e| CliError::failure(e.to_string()))?;
+    for warning in &loaded.warnings {
+        eprintln!("warning: {warning}");
+    }
+    print!("{}", info(&loaded.scene, &LightModel::unlit(Arc::new(loaded.scene.clone())).windows));
+    Ok(())
+}
+
+/// Compass name of a direction (x east, y north, z up).
+fn compass(direction: glam::Vec3) -> String {
+    if direction.z.abs() > 0.985 {
+        return if direction.z > 0.0 { "up".into() } else { "down".into() };
+    }
+    let azimuth = direction.x.atan2(direction.y).to_degrees().rem_euclid(360.0);
+    const NAMES: [&str; 8] = ["N", "NE", "E", "SE", "S", "SW", "W", "NW"];
+    let name = NAMES[((azimuth + 22.5) / 45.0) as usize % 8];
+    let tilt = direction.z.asin().to_degrees();
+    if tilt.abs() < 1.0 {
+        format!("{name} (azimuth {azimuth:.0}°)")
+    } else {
+        format!("{name} (azimuth {azimuth:.0}°, tilted {tilt:+.0}°)")
+    }
+}
+
+/// The `info` summary of a scene; windows face the way `windows` says
+/// (outward: the side that sees the sky).
+pub fn info(scene: &Scene, windows: &WindowGroups) -> String {
+    let mut out = String::new();
+    let site = &scene.site;
+    let (lo, hi) = scene.bounds;
+    let size = hi - lo;
+    let _ = writeln!(out, "scene      {}  ({})", scene.name, scene.files.scene.display());
+    let _ = writeln!(
+        out,
+        "model      {}  up {:?}, scale {} m/unit; {:.2} × {:.2} × {:.2} m (x east, y north, z up)",
+        scene.files.obj.display(),
+        scene.frame.up,
+        scene.frame.scale,
+        size.x,
+        size.y,
+        size.z
+    );
+    let _ = writeln!(
+        out,
+        "site       latitude {:.4}°, longitude {:.4}°, UTC{:+}, elevation {} m, ground reflectance {}",
+        site.latitude, site.longitude, site.timezone, site.elevation, site.ground_reflectance
+    );
+    let _ = writeln!(out, "triangles  {}", scene.triangles.len());
+    let _ = writeln!(out, "surfaces   {}", scene.surfaces.len());
+    let _ = writeln!(
+        out,
+        "patches    {} (patch size {} m, {} render triangles)",
+        scene.patches.patches.len(),
+        scene.patch_size,
+        scene.patches.triangles.len()
+    );
+    let _ = writeln!(out, "materials  {}", scene.materials.len());
+    for kind in ["diffuse", "glass", "panel"] {
+        let of_kind: Vec<String> = scene
+            .materials
+            .iter()
+            .filter(|m| m.kind.label() == kind)
+            .map(|m| match &m.kind {
+                MaterialKind::Diffuse { reflectance } => {
+                    let [r, g, b] = reflectance.0;
+                    if r == g && g == b { format!("{} ρ={r}", m.name) } else { format!("{} ρ=[{r}, {g}, {b}]", m.name) }
+                }
+                MaterialKind::Glass { transmittance } => format!("{} τ={transmittance}", m.name),
+                MaterialKind::Panel { panel, .. } => format!("{} ({panel})", m.name),
+            })
+            .collect();
+        let _ = writeln!(
+            out,
+            "  {kind:<8} {}{}",
+            of_kind.len(),
+            if of_kind.is_empty() { String::new() } else { format!(": {}", of_kind.join(", ")) }
+        );
+    }
+    let _ = writeln!(out, "windows    {}, {:.2} m² in all", scene.windows.len(), scene.window_area());
+    for (i, window) in scene.windows.iter().enumerate() {
+        let c = window.centroid;
+        let _ = writeln!(
+            out,
+            "  #{i:<3} {:<14} {:6.2} m²  facing {}  centre ({:.2}, {:.2}, {:.2})",
+            scene.material(window.material).name,
+            window.area,
+            compass(windows.outward[i].as_vec3()),
+            c.x,
+            c.y,
+            c.z
+        );
+    }
+    let points = scene.sensors.iter().filter(|s| s.size.is_none() && s.grid.is_none()).count();
+    let areas = scene.sensors.iter().filter(|s| s.size.is_some()).count();
+    let mut grids: Vec<(&str, usize)> = Vec::new();
+    for grid in scene.sensors.iter().filter_map(|s| s.grid.as_deref()) {
+        match grids.iter_mut().find(|(name, _)| *name == grid) {
+            Some((_, count)) => *count += 1,
+            None => grids.push((grid, 1)),
+        }
+    }
+    let grid_text: Vec<String> = grids.iter().map(|(name, count)| format!("{name} {count}")).collect();
+    let _ = writeln!(
+        out,
+        "sensors    {} ({points} point, {areas} area{})",
+        scene.sensors.len(),
+        if grid_text.is_empty() { String::new() } else { format!(", grids: {}", grid_text.join(", ")) }
+    );
+    if !scene.viewpoints.is_empty() {
+        let names: Vec<&str> = scene.viewpoints.iter().map(|v| v.name.as_str()).collect();
+        let _ = writeln!(out, "cameras    {}", names.join(", "));
+    }
+    out
+}

@@ -1,0 +1,87 @@
+//! `heliodon render`: a picture with the hybrid renderer, headless.
+
+use std::path::PathBuf;
+
+use crate::cli::CliError;
+use crate::cli::args::{SceneCase, in_range, load_for_command, parse_point};
+use crate::panel::PanelCatalog;
+use crate::render::offscreen::OffscreenRequest;
+use crate::render::{RenderMode, RenderSettings};
+use crate::scene::{DEFAULT_FOV, Viewpoint};
+
+#[derive(clap::Args, Debug)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub case: SceneCase,
+    /// PNG file to write
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Also write the physical image (radiance, W/sr/m² per channel; 179 lm/W) as a Radiance .hdr picture
+    #[arg(long, value_name = "FILE")]
+    pub hdr: Option<PathBuf>,
+    /// A viewpoint from the scene's [[cameras]]
+    #[arg(long, conflicts_with_all = ["eye", "target"])]
+    pub camera: Option<String>,
+    /// Eye position, model metres: X,Y,Z
+    #[arg(long, value_parser = parse_point, requires = "target")]
+    pub eye: Option<glam::Vec3>,
+    /// Point looked at: X,Y,Z
+    #[arg(long, value_parser = parse_point, requires = "eye")]
+    pub target: Option<glam::Vec3>,
+    /// Vertical field of view, degrees
+    #[arg(long, value_name = "DEG", value_parser = in_range(1.0, 170.0))]
+    pub fov: Option<f64>,
+    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    pub width: u32,
+    #[arg(long, default_value_t = 800, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    pub height: u32,
+    /// Exposure value (EV100); automatic from the scene's light when absent
+    #[arg(long, value_name = "EV", value_parser = in_range(-10.0, 30.0))]
+    pub exposure: Option<f64>,
+    /// full, sun, sky, indirect or falsecolor
+    #[arg(long, default_value = "full", value_parser = parse_mode)]
+    pub mode: RenderMode,
+}
+
+fn parse_mode(text: &str) -> Result<RenderMode, String> {
+    RenderMode::parse(text).ok_or_else(|| format!("'{text}' is not one of {}", RenderMode::NAMES.join(", ")))
+}
+
+/// Renders the view and writes the PNG (and the HDR).
+pub fn run(args: &RenderArgs, panels: &PanelCatalog) -> Result<(), CliError> {
+    let (case, sky) = (&args.case, args.case.sky.spec()?);
+    let scene = load_for_command(&case.scene, panels)?;
+    let mut view = match &args.camera {
+        Some(name) => Some(scene.viewpoints.iter().find(|v| &v.name == name).cloned().ok_or_else(|| {
+            let known: Vec<&str> = scene.viewpoints.iter().map(|v| v.name.as_str()).collect();
+            format!(
+                "--camera {name}: {} has no such camera (it has: {})",
+                case.scene.display(),
+                if known.is_empty() { "none".into() } else { known.join(", ") }
+            )
+        })?),
+        None => args.eye.zip(args.target).map(|(eye, target)| Viewpoint { name: "command line".into(), eye, target, fov: DEFAULT_FOV }),
+    };
+    if view.as_ref().is_some_and(|v| (v.eye - v.target).length() < 1e-6) {
+        return Err(CliError::failure("--eye and --target are the same point"));
+    }
+    if let Some(fov) = args.fov {
+        let base = view.unwrap_or_else(|| crate::render::initial_view(&scene));
+        view = Some(Viewpoint { fov: fov as f32, ..base });
+    }
+    let image = crate::render::offscreen::render(OffscreenRequest {
+        scene: case.scene.clone(),
+        view,
+        width: args.width,
+        height: args.height,
+        when: Some(case.when()),
+        sky: Some(sky),
+        settings: RenderSettings { mode: args.mode, exposure: args.exposure.map(|e| e as f32), ..Default::default() },
+        panels: panels.clone(),
+    })?;
+    image.save_png(&args.out)?;
+    if let Some(path) = &args.hdr {
+        image.save_hdr(path)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,112 @@
+//! `heliodon sensors`: lux at every sensor for dates × times, sharing one
+//! (cached) precomputation.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use crate::cli::CliError;
+use crate::cli::args::{Format, SkyArgs, load_for_command, precompute_progress, sky_for};
+use crate::light::{LightSettings, Lighting, cache};
+use crate::panel::PanelCatalog;
+use crate::time::{Date, LocalDateTime, TimeOfDay};
+
+#[derive(clap::Args, Debug)]
+pub struct SensorsArgs {
+    /// Scene file (TOML)
+    pub scene: PathBuf,
+    /// Local dates, YYYY-MM-DD, comma-separated for several
+    #[arg(long, value_parser = Date::parse, value_delimiter = ',', required = true)]
+    pub date: Vec<Date>,
+    /// Local standard times, HH:MM, comma-separated for several
+    #[arg(long, value_parser = TimeOfDay::parse, value_delimiter = ',', required = true)]
+    pub time: Vec<TimeOfDay>,
+    #[command(flatten)]
+    pub sky: SkyArgs,
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    pub format: Format,
+    /// Neither read nor write the precomputation cache
+    #[arg(long)]
+    pub no_cache: bool,
+}
+
+/// Prints the readings.
+pub fn run(args: &SensorsArgs, panels: &PanelCatalog) -> Result<(), CliError> {
+    print!("{}", sensors(args, panels)?);
+    Ok(())
+}
+
+/// The `sensors` command: one precomputation, then every date × time.
+pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, String> {
+    let spec = args.sky.spec()?;
+    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels)?);
+    let cache_dir = if args.no_cache { None } else { cache::default_dir() };
+    let progress = precompute_progress();
+    let (model, _) = cache::precompute_cached(scene.clone(), LightSettings::default(), cache_dir.as_deref(), &|done| {
+        progress.set_position((done * 1000.0) as u64)
+    })?;
+    progress.finish_and_clear();
+    for i in model.sensors_inside_solids() {
+        eprintln!(
+            "warning: {}: sensor '{}' seems to be inside a solid (every direction meets a back face); it reads what reaches it there",
+            args.scene.display(),
+            scene.sensors[i].name
+        );
+    }
+    let cases: Vec<LocalDateTime> =
+        args.date.iter().flat_map(|&date| args.time.iter().map(move |&time| LocalDateTime { date, time })).collect();
+    let several = cases.len() > 1;
+    let mut out = String::new();
+    let mut previous: Option<Lighting> = None;
+    if args.format == Format::Csv {
+        let _ = writeln!(out, "{}name,illuminance_lux,direct_sun_lux,direct_sky_lux,indirect_lux", if several { "date,time," } else { "" });
+    }
+    let mut json = Vec::new();
+    for when in cases {
+        let (position, sky) = sky_for(&scene, &spec, &args.sky.sky, when)?;
+        let lighting = model.solve(&sky, previous.as_ref());
+        match args.format {
+            Format::Csv => {
+                for r in &lighting.sensors {
+                    let prefix = if several { format!("{},{},", when.date, when.time) } else { String::new() };
+                    let _ = writeln!(out, "{prefix}{},{:.1},{:.1},{:.1},{:.1}", r.name, r.total, r.direct_sun, r.direct_sky, r.indirect);
+                }
+            }
+            Format::Json => {
+                let rows: Vec<String> = lighting
+                    .sensors
+                    .iter()
+                    .map(|r| {
+                        format!(
+                            "{{\"name\": {:?}, \"illuminance_lux\": {:.1}, \"direct_sun_lux\": {:.1}, \"direct_sky_lux\": {:.1}, \"indirect_lux\": {:.1}}}",
+                            r.name, r.total, r.direct_sun, r.direct_sky, r.indirect
+                        )
+                    })
+                    .collect();
+                json.push(format!(
+                    "{{\"date\": \"{}\", \"time\": \"{}\", \"sun_altitude_deg\": {:.4}, \"sun_azimuth_deg\": {:.4}, \"sky\": \"{}\", \"sensors\": [{}]}}",
+                    when.date, when.time, position.altitude, position.azimuth, args.sky.sky, rows.join(", ")
+                ));
+            }
+            Format::Table => {
+                let _ = writeln!(
+                    out,
+                    "{} {}  sun altitude {:.2}°, azimuth {:.2}°  sky {}",
+                    when.date, when.time, position.altitude, position.azimuth, args.sky.sky
+                );
+                let _ = writeln!(out, "{:<20} {:>10} {:>10} {:>10} {:>10}", "sensor", "total lx", "sun lx", "sky lx", "indirect lx");
+                for r in &lighting.sensors {
+                    let _ = writeln!(
+                        out,
+                        "{:<20} {:>10.1} {:>10.1} {:>10.1} {:>10.1}",
+                        r.name, r.total, r.direct_sun, r.direct_sky, r.indirect
+                    );
+                }
+            }
+        }
+        previous = Some(lighting);
+    }
+    if args.format == Format::Json {
+        let _ = writeln!(out, "{}", if several { format!("[{}]", json.join(", ")) } else { json.concat() });
+    }
+    Ok(out)
+}

@@ -1,0 +1,139 @@
+//! The `heliodon` command line (the contract is `shared/interface.md`; the
+//! README lists every flag): clap parses, each subcommand in
+//! [`commands`] runs, and every failure leaves through one path
+//! ([`CliError`]): one line on standard error, then its exit code.
+//!
+//! - [`args`]: flags shared by several commands (scene case, sky, format);
+//! - [`commands`]: `view`, `info`, `sensors`, `export-radiance`, `render`,
+//!   `sun`.
+
+pub mod args;
+pub mod commands;
+
+use std::fmt;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use crate::panel::PanelCatalog;
+use commands::export_radiance::ExportArgs;
+use commands::render::RenderArgs;
+use commands::sensors::SensorsArgs;
+use commands::sun::SunArgs;
+use commands::view::ViewArgs;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "heliodon",
+    version,
+    about = "Daylighting design: sun, sky and interreflected light on building models",
+    args_conflicts_with_subcommands = true,
+    allow_negative_numbers = true
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// Scene file (TOML) to open in the viewer; the bundled example when absent
+    pub scene: Option<PathBuf>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Open the interactive viewer
+    #[command(allow_negative_numbers = true)]
+    View(ViewArgs),
+    /// Print a summary of a scene: geometry, patches, materials, windows, sensors, site
+    Info {
+        /// Scene file (TOML)
+        scene: PathBuf,
+    },
+    /// Illuminance at the scene's sensors (lux): total, direct sun, direct sky, indirect
+    #[command(allow_negative_numbers = true)]
+    Sensors(SensorsArgs),
+    /// Write a Radiance model of the scene, sky and sensors, with a run.sh that computes the sensors in Radiance
+    #[command(name = "export-radiance", allow_negative_numbers = true)]
+    ExportRadiance(ExportArgs),
+    /// Draw a view of the scene lit by the sun and sky to a PNG, headless (any GPU or a software Vulkan driver)
+    #[command(allow_negative_numbers = true)]
+    Render(RenderArgs),
+    /// Sun position (NREL SPA) for a site and a local standard time, or the day's sunrise, noon and sunset
+    #[command(allow_negative_numbers = true)]
+    Sun(SunArgs),
+}
+
+/// Why a command failed: one line for standard error, and the exit code
+/// (2 for flags that do not fit together, 1 for everything else).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CliError {
+    pub message: String,
+    pub code: u8,
+}
+
+impl CliError {
+    /// A command that could not do its work (bad scene, unreadable file…): exit 1.
+    pub fn failure(message: impl Into<String>) -> Self {
+        Self { message: message.into(), code: 1 }
+    }
+
+    /// Flags that parse but do not fit together: exit 2, as clap's own errors.
+    pub fn usage(message: impl Into<String>) -> Self {
+        Self { message: message.into(), code: 2 }
+    }
+}
+
+impl From<String> for CliError {
+    fn from(message: String) -> Self {
+        Self::failure(message)
+    }
+}
+
+impl fmt::Display for CliError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+/// Parses the command line and runs it; `panels` are the panel types every
+/// scene may name (registered in every app it makes).
+pub fn main(panels: PanelCatalog) -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(error) => {
+            use clap::error::ErrorKind;
+            if matches!(
+                error.kind(),
+                ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            ) {
+                error.exit();
+            }
+            // clap's message on one line: what is wrong, without the usage and tips.
+            let rendered = error.render().to_string();
+            let message: Vec<&str> = rendered
+                .lines()
+                .take_while(|l| !l.starts_with("Usage:"))
+                .map(str::trim)
+                .filter(|l| !l.is_empty() && !l.starts_with("tip:") && !l.starts_with("For more information"))
+                .collect();
+            eprintln!("{} (see heliodon --help)", message.join(" "));
+            return ExitCode::from(2);
+        }
+    };
+    let done = |result: Result<(), CliError>| result.map(|()| ExitCode::SUCCESS);
+    let outcome = match cli.command {
+        None => commands::view::run(cli.scene, None, &panels),
+        Some(Command::View(args)) => commands::view::run(args.scene.clone(), Some(&args), &panels),
+        Some(Command::Info { scene }) => done(commands::info::run(&scene, &panels)),
+        Some(Command::Sensors(args)) => done(commands::sensors::run(&args, &panels)),
+        Some(Command::ExportRadiance(args)) => done(commands::export_radiance::run(&args, &panels)),
+        Some(Command::Render(args)) => done(commands::render::run(&args, &panels)),
+        Some(Command::Sun(args)) => {
+            commands::sun::run(&args);
+            Ok(ExitCode::SUCCESS)
+        }
+    };
+    outcome.unwrap_or_else(|error| {
+        eprintln!("error: {error}");
+        ExitCode::from(error.code)
+    })
+}
