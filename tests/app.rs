@@ -14,8 +14,8 @@ use heliodon::light::LightModel;
 use heliodon::panel::PanelCatalog;
 use heliodon::render::offscreen::{self, OffscreenRequest};
 use heliodon::render::reference::{self, SunComparison};
-use heliodon::render::{RenderMode, RenderSettings, initial_view};
-use heliodon::scene::{Scene, Viewpoint, load_scene};
+use heliodon::render::{RenderMode, RenderSettings, overview};
+use heliodon::scene::{Viewpoint, load_scene};
 use heliodon::sky::{Sky, SkySpec};
 use heliodon::sun::solar_position;
 use heliodon::time::{Date, LocalDateTime, TimeOfDay};
@@ -296,7 +296,7 @@ fn direct_sun_images_agree_with_a_ray_traced_reference() {
     for name in heliodon::BUNDLED_SCENES {
         let path = heliodon::bundled_scene(name);
         let scene = load_scene(&path, &PanelCatalog::new()).unwrap().scene;
-        let overview = initial_view(&Scene { viewpoints: Vec::new(), ..scene.clone() });
+        let overview = overview(&scene);
         let cases = [
             (&scene.viewpoints[0], "2026-03-21", "10:00"),
             (&scene.viewpoints[0], "2026-11-10", "14:30"),
@@ -468,7 +468,7 @@ fn camera_requests_move_the_camera_and_save_views() {
     open(&mut app, heliodon::bundled_scene("test_room")).unwrap();
     let camera = app.world_mut().spawn(CadCamera::looking(Vec3::new(2.0, 5.0, 1.6), Vec3::new(2.0, 0.0, 1.2))).id();
     let scene = app.world().resource::<ActiveScene>().scene.clone().unwrap();
-    let (centre, distance) = heliodon::render::framing(scene.bounds, heliodon::scene::DEFAULT_FOV);
+    let (centre, distance) = heliodon::render::framing(scene.focus, heliodon::scene::DEFAULT_FOV);
     app.world_mut().resource_mut::<CameraControl>().request = Some(CameraRequest::Top);
     app.update();
     let top = *app.world().get::<CadCamera>(camera).unwrap();

@@ -293,14 +293,22 @@ fn metered_luminance(
     (weight > 0.0).then(|| (sum / weight).exp())
 }
 
-/// The view a scene opens on: its first `[[cameras]]` entry, else the whole
-/// model seen from the south-west and above.
-pub fn initial_view(scene: &Scene) -> Viewpoint {
+/// The view a scene opens on: its first `[[cameras]]` entry, else a view
+/// from inside the room behind its largest windows looking out through them
+/// (`model` traces where the room's far wall and floor are), else the
+/// [`overview`].
+pub fn initial_view(scene: &Scene, model: Option<&LightModel>) -> Viewpoint {
     if let Some(first) = scene.viewpoints.first() {
         return first.clone();
     }
+    model.and_then(LightModel::interior_view).unwrap_or_else(|| overview(scene))
+}
+
+/// What the scene is about (its windows and sensors, [`Scene::focus`]) seen
+/// from the south-west and above: the building, not its site's ground.
+pub fn overview(scene: &Scene) -> Viewpoint {
     let fov = DEFAULT_FOV;
-    let (target, distance) = framing(scene.bounds, fov);
+    let (target, distance) = framing(scene.focus, fov);
     Viewpoint { name: "overview".into(), eye: target + Vec3::new(-0.55, -0.75, 0.55).normalize() * distance, target, fov }
 }
 

@@ -209,7 +209,7 @@ fn spawn_cameras(
         return;
     }
     let Some(scene) = &active.scene else { return };
-    let view = job.request.view.clone().unwrap_or_else(|| initial_view(scene));
+    let view = job.request.view.clone().unwrap_or_else(|| initial_view(scene, Some(&crate::light::LightModel::unlit(scene.clone()))));
     let (width, height) = (job.request.width, job.request.height);
     let picture = images.add(Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None));
     let physical = images.add(Image::new_target_texture(width, height, TextureFormat::Rgba32Float, None));

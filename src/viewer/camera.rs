@@ -2,7 +2,7 @@
 //! the cursor where it pressed (that point stays put on the screen; a click
 //! without a drag leaves the view alone), right- or middle-drag
 //! pans, the wheel zooms toward the point under the cursor, `F` frames the
-//! whole model. In walk mode (a panel checkbox) W/A/S/D move the eye at its
+//! building (the scene's focus: its windows and sensors). In walk mode (a panel checkbox) W/A/S/D move the eye at its
 //! height and left-drag looks around from it. z is up. The camera panel's
 //! presets and viewpoints arrive as [`CameraControl`] requests.
 
@@ -10,8 +10,8 @@ use bevy::input::mouse::{AccumulatedMouseScroll, MouseScrollUnit};
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
-use super::ViewerSystems;
 use super::focus::PanelFocus;
+use super::schedule::ViewerSystems;
 use crate::ecs::ActiveScene;
 use crate::render::framing;
 use crate::scene::Viewpoint;
@@ -209,7 +209,7 @@ pub fn navigate(
             && keys.just_pressed(KeyCode::KeyF)
             && let Some(scene) = &active.scene
         {
-            let (centre, distance) = framing(scene.bounds, fov.to_degrees());
+            let (centre, distance) = framing(scene.focus, fov.to_degrees());
             cad.focus = centre;
             cad.distance = distance;
         }
@@ -221,7 +221,7 @@ pub fn navigate(
 pub fn apply_camera_request(mut control: ResMut<CameraControl>, active: Res<ActiveScene>, mut cameras: Query<&mut CadCamera>) {
     let Some(request) = control.request.take() else { return };
     let Some(scene) = &active.scene else { return };
-    let (centre, distance) = framing(scene.bounds, crate::scene::DEFAULT_FOV);
+    let (centre, distance) = framing(scene.focus, crate::scene::DEFAULT_FOV);
     for mut camera in &mut cameras {
         let (yaw, pitch) = match &request {
             CameraRequest::Top => (-std::f32::consts::FRAC_PI_2, 1.5),

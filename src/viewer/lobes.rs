@@ -5,8 +5,8 @@
 
 use bevy::prelude::*;
 
-use super::ViewerSystems;
 use super::focus::PanelFocus;
+use super::schedule::ViewerSystems;
 use crate::ecs::{ActiveScene, SunSky};
 use crate::render::RayModel;
 

@@ -8,7 +8,8 @@
 //! - panel lobes ([`lobes`]), saving the view ([`capture`]),
 //! - the batch flow of `view --screenshot/--hdr/--sensor` ([`batch`]).
 //!
-//! The modules form a one-way graph: `focus` and `widgets` are leaves;
+//! The modules form a one-way graph: `schedule` (the system sets),
+//! `focus` and `widgets` are leaves;
 //! `camera`, `capture`, `sensors` and `lobes` read them; `ui` reads
 //! everything and nothing imports `ui`.
 
@@ -17,6 +18,7 @@ pub mod camera;
 pub mod capture;
 pub mod focus;
 pub mod lobes;
+pub mod schedule;
 pub mod sensors;
 pub mod ui;
 pub mod widgets;
@@ -28,6 +30,7 @@ use bevy::camera::visibility::RenderLayers;
 use bevy::prelude::*;
 
 pub use batch::ViewStart;
+pub use schedule::ViewerSystems;
 
 use crate::ecs::{ActiveScene, HeliodonPlugins, HeliodonSystems, OpenScene, RegisterPanel, SceneLoadFailed, SceneSpawned};
 use crate::render::{HeliodonRenderPlugin, initial_view};
@@ -36,21 +39,6 @@ use camera::CadCamera;
 /// The render layer of what is drawn over the model for the person looking
 /// (sensor markers, lobe arrows): not in saved luminance pictures.
 pub const OVERLAY_LAYER: usize = 1;
-
-/// The viewer's systems, in order. In `Update`, after the scene is spawned:
-/// 1. `Camera`: the camera panel's requests, then navigation;
-/// 2. `Sensors`: picking, and the selected sensor's day and year tasks;
-/// 3. `Overlays`: lobe arrows (after the sun and sky are updated).
-///
-/// In bevy_egui's `EguiPrimaryContextPass`: `Panels` (the egui panels and
-/// the 3D view's viewport), then `Overlays` (sensor markers and labels).
-#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum ViewerSystems {
-    Camera,
-    Sensors,
-    Panels,
-    Overlays,
-}
 
 /// Window, input, camera, panels.
 pub struct ViewerPlugin {
@@ -118,17 +106,26 @@ pub fn run(scene: PathBuf, panels: &crate::panel::PanelCatalog, start: Option<Vi
     }
 }
 
+/// A new scene opens on its first view, once its ray model is there (the
+/// automatic view looks for the room behind the windows); the same scene
+/// with edited materials keeps the camera.
 fn frame_new_scene(
     mut spawned: MessageReader<SceneSpawned>,
     active: Res<ActiveScene>,
+    ray_model: Option<Res<crate::render::RayModel>>,
+    mut pending: Local<bool>,
     mut cameras: Query<(&mut CadCamera, &mut Projection)>,
 ) {
-    // A new scene opens on its first view; the same one with edited materials keeps the camera.
-    if spawned.read().last().is_none_or(|s| s.edited) {
-        return;
+    if spawned.read().last().is_some_and(|s| !s.edited) {
+        *pending = true;
     }
     let Some(scene) = &active.scene else { return };
-    let view = initial_view(scene);
+    let model = ray_model.as_ref().map(|m| &m.0).filter(|m| std::sync::Arc::ptr_eq(&m.scene, scene));
+    if !*pending || (model.is_none() && scene.viewpoints.is_empty()) {
+        return;
+    }
+    *pending = false;
+    let view = initial_view(scene, model.map(|m| m.as_ref()));
     for (mut cad, mut projection) in &mut cameras {
         *cad = CadCamera::from_viewpoint(&view);
         *projection = Projection::Perspective(PerspectiveProjection { fov: view.fov.to_radians(), ..default() });

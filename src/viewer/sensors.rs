@@ -11,9 +11,9 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task, block_on, futures_lite::future};
 
-use super::ViewerSystems;
 use super::camera::cursor_in_view;
 use super::focus::PanelFocus;
+use super::schedule::ViewerSystems;
 pub use crate::day::{DAY_STEPS, YEAR_DAYS};
 use crate::day::{day_series, year_map_dates};
 use crate::ecs::{LightEngine, LightingState, Site, SkyChoice, SolarTime};

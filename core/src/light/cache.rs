@@ -2,11 +2,15 @@
 //! factors, sensor rays) are stored under a key hashed from the scene file,
 //! the OBJ, the MTLs, the light settings and this format's version; the BVH
 //! is rebuilt on load. A file whose header, length or checksum does not
-//! match is rebuilt, never trusted.
+//! match is rebuilt, never trusted. Files are written whole and renamed into
+//! place (a reader never sees half a file), and the folder is kept under a
+//! size bound ([`size_limit`]), least recently used files first to go;
+//! temporary files of processes that died mid-write are removed.
 
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::time::{Duration, SystemTime};
 
 use glam::DVec3;
 
@@ -17,7 +21,7 @@ use crate::sky::SkyPatches;
 
 const MAGIC: &[u8; 8] = b"HELIOLT\0";
 /// Bump when the model or its layout changes.
-const FORMAT: u32 = 4;
+const FORMAT: u32 = 5;
 
 /// What happened to the cache.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -120,7 +124,11 @@ pub fn precompute_cached(
     if let Ok(bytes) = fs::read(&path) {
         match decode(&bytes, key) {
             Ok(payload) => match LightModel::from_payload(scene.clone(), settings, &payload) {
-                Some(model) => return Ok((model, CacheOutcome::Hit(path))),
+                Some(model) => {
+                    // Used now: the last to be evicted.
+                    let _ = fs::File::options().append(true).open(&path).and_then(|f| f.set_modified(SystemTime::now()));
+                    return Ok((model, CacheOutcome::Hit(path)));
+                }
                 None => rebuilt = Some("its contents do not fit the scene".to_string()),
             },
             Err(why) => rebuilt = Some(why),
@@ -133,12 +141,60 @@ pub fn precompute_cached(
         fs::write(&partial, encode(&model.payload(), key))?;
         fs::rename(&partial, &path)
     });
+    if stored.is_ok() {
+        tidy(dir, &path, size_limit());
+    }
     let outcome = match (stored, rebuilt) {
         (Err(e), _) => CacheOutcome::Skipped(format!("cannot write {}: {e}", path.display())),
         (Ok(()), Some(why)) => CacheOutcome::Rebuilt(path, why),
         (Ok(()), None) => CacheOutcome::Stored(path),
     };
     Ok((model, outcome))
+}
+
+/// The cache folder's bound in bytes: `$HELIODON_CACHE_MAX_MB` (MiB), else
+/// 2 GiB. Past it, the least recently used files go.
+pub fn size_limit() -> u64 {
+    const DEFAULT_MIB: u64 = 2048;
+    std::env::var("HELIODON_CACHE_MAX_MB").ok().and_then(|v| v.trim().parse::<u64>().ok()).unwrap_or(DEFAULT_MIB) << 20
+}
+
+/// Temporary files older than this were left by a process that died while writing.
+const STALE_TEMPORARY: Duration = Duration::from_secs(3600);
+
+/// Keeps `dir` within `limit` bytes: removes temporary files left by
+/// processes that died mid-write, then the least recently used cache files
+/// (never `keep`, the one just written).
+pub fn tidy(dir: &Path, keep: &Path, limit: u64) {
+    let Ok(entries) = fs::read_dir(dir) else { return };
+    let now = SystemTime::now();
+    let mut files: Vec<(SystemTime, u64, PathBuf)> = Vec::new();
+    for entry in entries.flatten() {
+        let path = entry.path();
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Ok(meta) = entry.metadata() else { continue };
+        let modified = meta.modified().unwrap_or(now);
+        if !name.starts_with("light-") || !meta.is_file() {
+            continue;
+        }
+        if name.contains(".tmp") {
+            if now.duration_since(modified).unwrap_or_default() > STALE_TEMPORARY {
+                let _ = fs::remove_file(&path);
+            }
+            continue;
+        }
+        files.push((modified, meta.len(), path));
+    }
+    let mut total: u64 = files.iter().map(|f| f.1).sum();
+    files.sort();
+    for (_, size, path) in files {
+        if total <= limit {
+            break;
+        }
+        if path != keep && fs::remove_file(&path).is_ok() {
+            total -= size;
+        }
+    }
 }
 
 fn encode(payload: &[u8], key: u64) -> Vec<u8> {
@@ -197,10 +253,23 @@ impl Writer {
         self.f64(v.z);
     }
 
+    /// A LEB128 variable-length integer (small numbers take one byte).
+    pub fn varint(&mut self, mut v: u32) {
+        while v >= 0x80 {
+            self.0.push((v as u8) | 0x80);
+            v >>= 7;
+        }
+        self.0.push(v as u8);
+    }
+
+    /// Sparse rows sorted by index: each index as its step from the one
+    /// before (mostly one or two bytes), each share as it is (bit-exact).
     pub fn pairs(&mut self, pairs: &[(u32, f32)]) {
         self.u32(pairs.len() as u32);
+        let mut previous = 0;
         for &(i, w) in pairs {
-            self.u32(i);
+            self.varint(i - previous);
+            previous = i;
             self.f32(w);
         }
     }
@@ -240,12 +309,30 @@ impl Reader<'_> {
         Some(DVec3::new(self.f64()?, self.f64()?, self.f64()?))
     }
 
+    pub fn varint(&mut self) -> Option<u32> {
+        let mut v: u32 = 0;
+        for shift in (0..35).step_by(7) {
+            let byte = *self.take(1)?.first()?;
+            v |= u32::from(byte & 0x7f).checked_shl(shift)?;
+            if byte & 0x80 == 0 {
+                return Some(v);
+            }
+        }
+        None
+    }
+
     pub fn pairs(&mut self) -> Option<Vec<(u32, f32)>> {
         let n = self.u32()? as usize;
-        if n > self.0.len() / 8 {
+        if n > self.0.len() / 5 {
             return None;
         }
-        (0..n).map(|_| Some((self.u32()?, self.f32()?))).collect()
+        let mut previous: u32 = 0;
+        (0..n)
+            .map(|_| {
+                previous = previous.checked_add(self.varint()?)?;
+                Some((previous, self.f32()?))
+            })
+            .collect()
     }
 
     pub fn gather(&mut self) -> Option<Gather> {
@@ -318,5 +405,40 @@ impl SensorGeometry {
         let n = count(r, 20)?;
         let hits = (0..n).map(|_| Some((r.u32()?, r.f32()?, [r.f32()?, r.f32()?, r.f32()?]))).collect::<Option<Vec<_>>>()?;
         Some(Self { sun_points, normal, gather, hits })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The folder stays under its bound: least recently used files go
+    /// first, never the one just written; stale temporary files go too.
+    #[test]
+    fn the_folder_is_kept_under_its_bound() {
+        let dir = std::env::temp_dir().join(format!("heliodon-cache-tidy-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap();
+        let now = SystemTime::now();
+        let file = |name: &str, bytes: usize, age_s: u64| {
+            let path = dir.join(name);
+            fs::write(&path, vec![0u8; bytes]).unwrap();
+            fs::File::options().append(true).open(&path).unwrap().set_modified(now - Duration::from_secs(age_s)).unwrap();
+            path
+        };
+        let oldest = file("light-0000000000000001.bin", 1000, 300);
+        let older = file("light-0000000000000002.bin", 1000, 200);
+        let newest = file("light-0000000000000003.bin", 1000, 100);
+        let written = file("light-0000000000000004.bin", 1000, 400);
+        let stale = file("light-0000000000000005.tmp42", 10, 7200);
+        let fresh = file("light-0000000000000006.tmp43", 10, 10);
+        let other = file("notes.txt", 5000, 9000);
+        tidy(&dir, &written, 2500);
+        let exists = |p: &PathBuf| p.exists();
+        assert!(!exists(&oldest) && !exists(&older), "the least recently used go");
+        assert!(exists(&newest) && exists(&written), "the newest and the one just written stay");
+        assert!(!exists(&stale) && exists(&fresh), "only stale temporary files go");
+        assert!(exists(&other), "files that are not the cache's are left alone");
+        let _ = fs::remove_dir_all(&dir);
     }
 }

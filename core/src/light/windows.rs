@@ -74,3 +74,33 @@ fn outward_normal(tracer: &Tracer, window: &Window) -> DVec3 {
     let against = open(-normal, &mut rng);
     if along > against { normal } else { -normal }
 }
+
+/// Eye height above the floor for an automatic view, m.
+const EYE_HEIGHT: f32 = 1.5;
+
+impl super::LightModel {
+    /// A view from inside the room behind the largest group of vertical
+    /// windows, looking out through them: the eye at eye height in the back
+    /// corner (toward the far wall, then toward a side wall), looking at the
+    /// windows' middle a metre above the floor, so the floor's sun patches
+    /// and the windows are both in view. `None` without vertical windows.
+    pub fn interior_view(&self) -> Option<crate::scene::Viewpoint> {
+        let scene = &self.scene;
+        let area = |g: &WindowGroup| g.windows.iter().map(|&w| scene.windows[w as usize].area).sum::<f32>();
+        let group = self.windows.groups.iter().filter(|g| g.outward.z.abs() < 0.7).max_by(|a, b| area(a).total_cmp(&area(b)))?;
+        let centre = group.windows.iter().map(|&w| scene.windows[w as usize].centroid * scene.windows[w as usize].area).sum::<glam::Vec3>()
+            / area(group);
+        let inward = -glam::Vec3::new(group.outward.x as f32, group.outward.y as f32, 0.0).normalize();
+        let across = inward.cross(glam::Vec3::Z);
+        // How far a ray goes from `from` along `direction` before a surface (`fallback` if none).
+        let reach = |from: glam::Vec3, direction: glam::Vec3, fallback: f32| {
+            self.trace(from.as_dvec3(), direction.as_dvec3()).map_or(fallback, |(_, d)| d as f32)
+        };
+        let mut eye = centre + inward * (0.85 * reach(centre + inward * 0.05, inward, 5.0));
+        eye += across * (0.6 * reach(eye, across, 2.0));
+        let floor = eye.z - reach(eye, glam::Vec3::NEG_Z, EYE_HEIGHT);
+        eye.z = floor + EYE_HEIGHT;
+        let target = glam::Vec3::new(centre.x, centre.y, floor + 1.0);
+        Some(crate::scene::Viewpoint { name: "inside".into(), eye, target, fov: crate::scene::DEFAULT_FOV })
+    }
+}

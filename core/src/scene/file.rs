@@ -55,6 +55,9 @@ pub struct ModelTable {
 #[serde(deny_unknown_fields)]
 pub struct LightingTable {
     pub patch_size: Option<Spanned<f64>>,
+    /// `false`: patches of `patch_size` everywhere (no coarser ones away
+    /// from the windows and sensors).
+    pub adaptive: Option<bool>,
 }
 
 /// A material's keys stay loose here: which keys are allowed depends on its
@@ -101,6 +104,8 @@ pub struct ParsedScene {
     pub frame: ModelFrame,
     /// `[lighting] patch_size`, or the default.
     pub patch_size: f32,
+    /// `[lighting] adaptive` (default true): patches coarser away from the focus.
+    pub adaptive_patches: bool,
     pub model: ModelTable,
     pub materials: BTreeMap<String, Spanned<MaterialTable>>,
     pub sensors: Vec<Spanned<SensorTable>>,
@@ -161,6 +166,7 @@ pub fn parse(path: &Path, text: &str) -> Result<ParsedScene, SceneError> {
         site: Site::new(0.0, 0.0, 0.0),
         frame: ModelFrame::default(),
         patch_size: DEFAULT_PATCH_SIZE,
+        adaptive_patches: true,
         model: file.model.into_inner(),
         materials: file.materials,
         sensors: file.sensors,
@@ -170,8 +176,11 @@ pub fn parse(path: &Path, text: &str) -> Result<ParsedScene, SceneError> {
     parsed.name = file.name.unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
     parsed.site = site(&parsed, file.site.get_ref())?;
     parsed.frame = frame(&parsed)?;
-    if let Some(size) = file.lighting.and_then(|l| l.patch_size) {
-        parsed.patch_size = parsed.number(&size, "lighting.patch_size", (0.01, 1000.0))? as f32;
+    if let Some(lighting) = file.lighting {
+        if let Some(size) = lighting.patch_size {
+            parsed.patch_size = parsed.number(&size, "lighting.patch_size", (0.01, 1000.0))? as f32;
+        }
+        parsed.adaptive_patches = lighting.adaptive.unwrap_or(true);
     }
     Ok(parsed)
 }

@@ -26,7 +26,7 @@ use glam::Vec3;
 pub use error::{Location, SceneError, SceneWarning, line_of};
 pub use frame::{ModelFrame, UpAxis};
 pub use material::{Material, MaterialKind, MaterialOrigin, Rgb};
-pub use patches::{Patch, PatchMesh};
+pub use patches::{Patch, PatchMesh, PatchSizing};
 pub use sensors::{DEFAULT_FOV, Sensor, Viewpoint};
 
 use crate::panel::PanelCatalog;
@@ -69,6 +69,10 @@ pub struct Scene {
     pub viewpoints: Vec<Viewpoint>,
     /// Axis-aligned bounds of all triangles: (min, max).
     pub bounds: (Vec3, Vec3),
+    /// The bounds of what the scene is about: its windows and sensors (the
+    /// whole model's bounds when it has neither). Patches are finest around
+    /// it, and views frame it rather than a site's ground.
+    pub focus: (Vec3, Vec3),
 }
 
 /// The files a scene was read from, as the user would name them.
@@ -222,11 +226,25 @@ fn build(
     let (materials, material_of) = material::resolve(&parsed, &model, panels, &obj_path, &mut warnings)?;
     let raw_triangles = obj::triangles(&model, &parsed.frame, &material_of, &obj_path, &mut warnings)?;
     let (triangles, mut surfaces) = surfaces::group(raw_triangles);
-    let patches = patches::subdivide(&triangles, &mut surfaces, parsed.patch_size);
     let windows = surfaces::windows(&triangles, &surfaces, &materials);
     let sensors = sensors::sensors(&parsed)?;
+    // Patches are finest around the windows and the sensors (see `patches`).
+    let window_corners = windows.iter().flat_map(|w| {
+        let range = surfaces[w.surface as usize].triangles.clone();
+        triangles[range.start as usize..range.end as usize].iter().flat_map(|t| t.vertices)
+    });
+    let focus = window_corners
+        .chain(sensors.iter().map(|s| s.position))
+        .fold(None, |b: Option<(Vec3, Vec3)>, p| Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p)))));
+    let sizing =
+        if parsed.adaptive_patches { PatchSizing::around(parsed.patch_size, focus) } else { PatchSizing::uniform(parsed.patch_size) };
+    // Clutter gathers into clusters; windows keep patches of their own.
+    let clusterable: Vec<bool> =
+        surfaces.iter().map(|s| matches!(materials[s.material as usize].kind, MaterialKind::Diffuse { .. })).collect();
+    let patches = patches::subdivide(&triangles, &mut surfaces, &sizing, &clusterable);
     let viewpoints = sensors::viewpoints(&parsed)?;
     let bounds = bounds(&triangles);
+    let focus = focus.unwrap_or(bounds);
     Ok(LoadedScene {
         scene: Scene {
             name: parsed.name.clone(),
@@ -242,6 +260,7 @@ fn build(
             sensors,
             viewpoints,
             bounds,
+            focus,
         },
         warnings,
     })

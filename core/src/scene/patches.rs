@@ -1,8 +1,24 @@
-//! The patch mesh for lighting: each surface cut along a square grid of
-//! `patch_size` laid in its plane. A patch is one grid cell's part of the
-//! surface; the pieces of triangles inside the cell are its render
-//! triangles. Triangles smaller than a cell are not cut: they join the cell
-//! that holds their centroid.
+//! The patch mesh for lighting. Patches are fine where the light needs
+//! them and coarse where it does not: each surface is cut by a quadtree of
+//! square cells in its plane, whose finest cells are the `patch_size` grid
+//! laid from the surface's corner. A cell is split while it is larger than
+//! the size allowed where it lies ([`PatchSizing`]): `patch_size` in the
+//! *focus* (the box around the windows and the sensors, with a margin), and
+//! growing with the distance from it (a quarter of that distance, at most
+//! 64 × `patch_size`). So a room keeps today's grid, while the far ground,
+//! the site's context and the outside of the building far from its windows
+//! get a few large patches. A patch is one leaf cell's part of the surface;
+//! the pieces of triangles inside the cell are its render triangles.
+//! Triangles smaller than their cell are not cut: they join the cell that
+//! holds their centroid (small coplanar triangles gather into patches).
+//!
+//! Clutter (furniture, frames, mullions: diffuse surfaces much smaller than
+//! the patch size allowed where they are) would otherwise be one patch per
+//! surface. Such surfaces are gathered into *clusters*: per material, per
+//! cube of the allowed size and per main direction of their normals (±x,
+//! ±y, ±z), one patch holding all their triangles, with the area-weighted
+//! mean normal. The cluster's patch is listed under its first surface; the
+//! others have none of their own.
 
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -39,6 +55,32 @@ pub struct PatchMesh {
 }
 
 impl PatchMesh {
+    /// Adds one patch holding the whole triangles of the surfaces `cluster`,
+    /// listed under the first of them.
+    fn push_cluster(&mut self, triangles: &[Triangle], surfaces: &[Surface], cluster: &[u32]) {
+        let start = self.triangles.len() as u32;
+        let (mut area, mut moment, mut normal) = (0.0, Vec3::ZERO, Vec3::ZERO);
+        for &member in cluster {
+            let surface = &surfaces[member as usize];
+            for triangle in &triangles[surface.triangles.start as usize..surface.triangles.end as usize] {
+                let a = triangle.area();
+                area += a;
+                moment += a * triangle.centroid();
+                normal += a * surface.normal;
+                self.triangles.push(triangle.vertices);
+            }
+        }
+        let first = &surfaces[cluster[0] as usize];
+        self.patches.push(Patch {
+            surface: cluster[0],
+            material: first.material,
+            area,
+            normal: normal.try_normalize().unwrap_or(first.normal),
+            centroid: moment / area.max(f32::MIN_POSITIVE),
+            triangles: start..self.triangles.len() as u32,
+        });
+    }
+
     /// The patch each render triangle belongs to.
     pub fn triangle_patches(&self) -> Vec<u32> {
         let mut owner = vec![0; self.triangles.len()];
@@ -52,50 +94,224 @@ impl PatchMesh {
 /// Pieces smaller than this (m²) are rounding slivers of clipping.
 const SLIVER_AREA: f32 = 1e-8;
 
-/// Cuts every surface into patches no larger than `size` × `size` and sets
-/// each surface's patch range.
-pub fn subdivide(triangles: &[Triangle], surfaces: &mut [Surface], size: f32) -> PatchMesh {
+/// Beyond the focus, the allowed patch side grows by this much per metre.
+const GROWTH: f32 = 0.25;
+/// The largest patch side, in finest sizes.
+const COARSEST: f32 = 64.0;
+/// The focus box reaches this far (m) beyond the windows and sensors.
+const FOCUS_MARGIN: f32 = 1.5;
+
+/// The patch side allowed at each place: `finest` in the focus, larger with
+/// the distance from it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PatchSizing {
+    /// `patch_size`: the side of the finest patches, m.
+    pub finest: f32,
+    /// The box (min, max) where patches are finest; `None`: finest everywhere.
+    pub focus: Option<(Vec3, Vec3)>,
+}
+
+impl PatchSizing {
+    /// Finest everywhere: the uniform `size` grid.
+    pub fn uniform(size: f32) -> Self {
+        Self { finest: size, focus: None }
+    }
+
+    /// Finest within [`FOCUS_MARGIN`] of the box `focus` (around the
+    /// windows and the sensors); finest everywhere without one.
+    pub fn around(size: f32, focus: Option<(Vec3, Vec3)>) -> Self {
+        Self { finest: size, focus: focus.map(|(lo, hi)| (lo - Vec3::splat(FOCUS_MARGIN), hi + Vec3::splat(FOCUS_MARGIN))) }
+    }
+
+    /// The side allowed for a cell with `centre` and half-diagonal `reach`:
+    /// set by the cell's nearest point to the focus.
+    fn allowed(&self, centre: Vec3, reach: f32) -> f32 {
+        let Some((lo, hi)) = self.focus else { return self.finest };
+        let outside = (lo - centre).max(centre - hi).max(Vec3::ZERO).length();
+        let distance = (outside - reach).max(0.0);
+        (self.finest + GROWTH * distance).min(self.finest * COARSEST)
+    }
+}
+
+/// A square cell of a surface's quadtree, in finest-grid units from the
+/// surface's corner: columns `i..i + 2^level`, rows `j..j + 2^level`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+struct Cell {
+    i: i64,
+    j: i64,
+    level: u32,
+}
+
+/// A surface's plane and its quadtree's leaves.
+struct Quadtree<'a> {
+    sizing: &'a PatchSizing,
+    u: Vec3,
+    v: Vec3,
+    /// The plane's offset along its normal, and the normal.
+    offset: f32,
+    normal: Vec3,
+    /// The finest grid's corner (u, v).
+    origin: (f32, f32),
+    root: Cell,
+}
+
+impl Quadtree<'_> {
+    fn span(&self, cell: Cell) -> i64 {
+        1 << cell.level
+    }
+
+    /// The cell's bounds in the plane: (u0, v0, side).
+    fn bounds(&self, cell: Cell) -> (f32, f32, f32) {
+        let size = self.sizing.finest;
+        (self.origin.0 + cell.i as f32 * size, self.origin.1 + cell.j as f32 * size, self.span(cell) as f32 * size)
+    }
+
+    fn is_leaf(&self, cell: Cell) -> bool {
+        if cell.level == 0 {
+            return true;
+        }
+        let (u0, v0, side) = self.bounds(cell);
+        let centre = self.u * (u0 + side / 2.0) + self.v * (v0 + side / 2.0) + self.normal * self.offset;
+        side <= self.sizing.allowed(centre, side * std::f32::consts::FRAC_1_SQRT_2)
+    }
+
+    fn children(&self, cell: Cell) -> [Cell; 4] {
+        let half = self.span(cell) / 2;
+        let level = cell.level - 1;
+        [(0, 0), (half, 0), (0, half), (half, half)].map(|(di, dj)| Cell { i: cell.i + di, j: cell.j + dj, level })
+    }
+
+    /// The leaf holding finest cell (i, j).
+    fn leaf_at(&self, (i, j): (i64, i64)) -> Cell {
+        let mut cell = self.root;
+        while !self.is_leaf(cell) {
+            let half = self.span(cell) / 2;
+            let (di, dj) = (i64::from(i >= cell.i + half) * half, i64::from(j >= cell.j + half) * half);
+            cell = Cell { i: cell.i + di, j: cell.j + dj, level: cell.level - 1 };
+        }
+        cell
+    }
+
+    /// The leaves overlapping finest cells `lo..=hi`, into `out`.
+    fn leaves_over(&self, cell: Cell, lo: (i64, i64), hi: (i64, i64), out: &mut Vec<Cell>) {
+        let span = self.span(cell);
+        if cell.i > hi.0 || cell.j > hi.1 || cell.i + span <= lo.0 || cell.j + span <= lo.1 {
+            return;
+        }
+        if self.is_leaf(cell) {
+            out.push(cell);
+            return;
+        }
+        for child in self.children(cell) {
+            self.leaves_over(child, lo, hi, out);
+        }
+    }
+}
+
+/// Surfaces smaller than this share of the allowed patch's area are clutter.
+const CLUTTER: f32 = 0.25;
+
+/// The clusters of clutter: per surface, its cluster (index into the
+/// returned list of member lists), for the surfaces that `clusterable`
+/// allows and that are small where they lie.
+fn clusters(triangles: &[Triangle], surfaces: &[Surface], sizing: &PatchSizing, clusterable: &[bool]) -> (Vec<Option<u32>>, Vec<Vec<u32>>) {
+    let mut keys: BTreeMap<(u32, u8, [i64; 3]), u32> = BTreeMap::new();
+    let mut members: Vec<Vec<u32>> = Vec::new();
+    let mut cluster_of = vec![None; surfaces.len()];
+    for (index, surface) in surfaces.iter().enumerate() {
+        let tris = &triangles[surface.triangles.start as usize..surface.triangles.end as usize];
+        let centroid = tris.iter().map(|t| t.centroid() * t.area()).sum::<Vec3>() / surface.area.max(f32::MIN_POSITIVE);
+        let allowed = sizing.allowed(centroid, 0.0);
+        if !clusterable[index] || surface.area >= CLUTTER * allowed * allowed {
+            continue;
+        }
+        // Cubes of the allowed side, nested on the finest grid.
+        let side = sizing.finest * (allowed / sizing.finest).log2().floor().exp2();
+        let cube = (centroid / side).floor().as_i64vec3().to_array();
+        let n = surface.normal;
+        let axis = n.abs().max_position();
+        let direction = (2 * axis + usize::from(n[axis] < 0.0)) as u8;
+        let next = members.len() as u32;
+        let cluster = *keys.entry((surface.material, direction, cube)).or_insert(next);
+        if cluster == next {
+            members.push(Vec::new());
+        }
+        members[cluster as usize].push(index as u32);
+        cluster_of[index] = Some(cluster);
+    }
+    (cluster_of, members)
+}
+
+/// Cuts every surface into patches no larger than `sizing` allows, gathers
+/// the clutter among the surfaces `clusterable` allows into clusters, and
+/// sets each surface's patch range.
+pub fn subdivide(triangles: &[Triangle], surfaces: &mut [Surface], sizing: &PatchSizing, clusterable: &[bool]) -> PatchMesh {
+    let size = sizing.finest;
     let mut mesh = PatchMesh::default();
-    for (index, surface) in surfaces.iter_mut().enumerate() {
+    let (cluster_of, members) = clusters(triangles, surfaces, sizing, clusterable);
+    for index in 0..surfaces.len() {
+        let first_patch = mesh.patches.len() as u32;
+        if let Some(cluster) = cluster_of[index] {
+            let cluster = &members[cluster as usize];
+            // The cluster's patch goes with its first surface.
+            if cluster[0] == index as u32 {
+                mesh.push_cluster(triangles, surfaces, cluster);
+            }
+            surfaces[index].patches = first_patch..mesh.patches.len() as u32;
+            continue;
+        }
+        let surface = &mut surfaces[index];
         let tris = &triangles[surface.triangles.start as usize..surface.triangles.end as usize];
         let (u, v) = plane_axes(surface.normal);
         let origin =
             tris.iter().flat_map(|t| t.vertices).fold((f32::INFINITY, f32::INFINITY), |(a, b), p| (a.min(p.dot(u)), b.min(p.dot(v))));
-        let cell_of = |p: Vec3| (((p.dot(u) - origin.0) / size).floor() as i32, ((p.dot(v) - origin.1) / size).floor() as i32);
-        let mut cells: BTreeMap<(i32, i32), Vec<[Vec3; 3]>> = BTreeMap::new();
+        let cell_of = |p: Vec3| (((p.dot(u) - origin.0) / size).floor() as i64, ((p.dot(v) - origin.1) / size).floor() as i64);
+        let extent = tris.iter().flat_map(|t| t.vertices).map(cell_of).fold(0, |m, (i, j)| m.max(i).max(j)) + 1;
+        let level = (extent.max(1) as u64).next_power_of_two().trailing_zeros();
+        let tree = Quadtree {
+            sizing,
+            u,
+            v,
+            offset: surface.normal.dot(tris[0].vertices[0]),
+            normal: surface.normal,
+            origin,
+            root: Cell { i: 0, j: 0, level },
+        };
+        let mut cells: BTreeMap<(i64, i64), Vec<[Vec3; 3]>> = BTreeMap::new();
+        let mut leaves = Vec::new();
         for triangle in tris {
             let [a, b, c] = triangle.vertices;
             let longest = (b - a).length().max((c - b).length()).max((a - c).length());
-            if longest <= size {
-                cells.entry(cell_of(triangle.centroid())).or_default().push(triangle.vertices);
+            let home = tree.leaf_at(cell_of(triangle.centroid()));
+            if longest <= tree.bounds(home).2 {
+                cells.entry((home.i, home.j)).or_default().push(triangle.vertices);
                 continue;
             }
             let (lo, hi) =
-                triangle.vertices.iter().map(|&p| cell_of(p)).fold(((i32::MAX, i32::MAX), (i32::MIN, i32::MIN)), |(lo, hi), (i, j)| {
+                triangle.vertices.iter().map(|&p| cell_of(p)).fold(((i64::MAX, i64::MAX), (i64::MIN, i64::MIN)), |(lo, hi), (i, j)| {
                     ((lo.0.min(i), lo.1.min(j)), (hi.0.max(i), hi.1.max(j)))
                 });
-            for i in lo.0..=hi.0 {
-                for j in lo.1..=hi.1 {
-                    let u0 = origin.0 + i as f32 * size;
-                    let v0 = origin.1 + j as f32 * size;
-                    let mut polygon = triangle.vertices.to_vec();
-                    for (axis, bound, keep_above) in [(u, u0, true), (u, u0 + size, false), (v, v0, true), (v, v0 + size, false)] {
-                        polygon = clip(&polygon, axis, bound, keep_above);
-                        if polygon.len() < 3 {
-                            break;
-                        }
+            leaves.clear();
+            tree.leaves_over(tree.root, lo, hi, &mut leaves);
+            leaves.sort_unstable();
+            for &leaf in &leaves {
+                let (u0, v0, side) = tree.bounds(leaf);
+                let mut polygon = triangle.vertices.to_vec();
+                for (axis, bound, keep_above) in [(u, u0, true), (u, u0 + side, false), (v, v0, true), (v, v0 + side, false)] {
+                    polygon = clip(&polygon, axis, bound, keep_above);
+                    if polygon.len() < 3 {
+                        break;
                     }
-                    let pieces = cells.entry((i, j)).or_default();
-                    for k in 1..polygon.len().saturating_sub(1) {
-                        let piece = [polygon[0], polygon[k], polygon[k + 1]];
-                        if 0.5 * (piece[1] - piece[0]).cross(piece[2] - piece[0]).length() > SLIVER_AREA {
-                            pieces.push(piece);
-                        }
+                }
+                let pieces = cells.entry((leaf.i, leaf.j)).or_default();
+                for k in 1..polygon.len().saturating_sub(1) {
+                    let piece = [polygon[0], polygon[k], polygon[k + 1]];
+                    if 0.5 * (piece[1] - piece[0]).cross(piece[2] - piece[0]).length() > SLIVER_AREA {
+                        pieces.push(piece);
                     }
                 }
             }
         }
-        let first_patch = mesh.patches.len() as u32;
         for pieces in cells.into_values().filter(|p| !p.is_empty()) {
             let start = mesh.triangles.len() as u32;
             let mut area = 0.0;
@@ -170,7 +386,7 @@ mod tests {
     fn a_wall_becomes_a_grid_of_square_patches_that_conserve_area() {
         let tris = quad(4.0, 3.0);
         let mut surfaces = vec![surface_of(&tris)];
-        let mesh = subdivide(&tris, &mut surfaces, 0.5);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false]);
         assert_eq!(mesh.patches.len(), 8 * 6);
         assert_eq!(surfaces[0].patches, 0..48);
         for patch in &mesh.patches {
@@ -194,7 +410,7 @@ mod tests {
     fn a_partial_cell_keeps_its_share() {
         let tris = quad(1.2, 0.5);
         let mut surfaces = vec![surface_of(&tris)];
-        let mesh = subdivide(&tris, &mut surfaces, 0.5);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false]);
         let mut areas: Vec<f32> = mesh.patches.iter().map(|p| p.area).collect();
         areas.sort_by(f32::total_cmp);
         assert_eq!(areas.len(), 3);
@@ -214,10 +430,46 @@ mod tests {
             })
             .collect();
         let mut surfaces = vec![surface_of(&tris)];
-        let mesh = subdivide(&tris, &mut surfaces, 0.5);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false]);
         assert_eq!(mesh.triangles.len(), 6);
         assert_eq!(mesh.patches.len(), 2);
         let total: f32 = mesh.patches.iter().map(|p| p.area).sum();
         assert!((total - 0.27).abs() < 1e-5);
+    }
+
+    #[test]
+    fn clutter_gathers_into_one_patch_per_cube_and_direction() {
+        // 40 small squares (0.1 m) in one 0.5 m cube: 20 facing up, 20 facing south.
+        let mut tris = Vec::new();
+        let mut surfaces = Vec::new();
+        for k in 0..40 {
+            let offset = Vec3::new(0.02 + 0.01 * (k % 20) as f32, 0.1, 0.1 + 0.01 * (k % 7) as f32);
+            let square: Vec<Triangle> = quad(0.1, 0.1)
+                .into_iter()
+                .map(|mut t| {
+                    if k >= 20 {
+                        // Turned to face up: (x, 0, z) -> (x, -z, 0).
+                        t.vertices = t.vertices.map(|p| Vec3::new(p.x, p.z, 0.0));
+                    }
+                    t.vertices = t.vertices.map(|p| p + offset);
+                    t
+                })
+                .collect();
+            let start = tris.len() as u32;
+            tris.extend(square.iter().copied());
+            surfaces.push(Surface { triangles: start..tris.len() as u32, ..surface_of(&square) });
+        }
+        let clusterable = vec![true; surfaces.len()];
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &clusterable);
+        assert_eq!(mesh.patches.len(), 2, "{:?}", mesh.patches.iter().map(|p| p.normal).collect::<Vec<_>>());
+        let area: f32 = mesh.patches.iter().map(|p| p.area).sum();
+        assert!((area - 0.4).abs() < 1e-5, "{area}");
+        assert_eq!(mesh.triangles.len(), 80);
+        // Each cluster's patch is listed under its first surface; the others have none.
+        let listed: Vec<usize> = surfaces.iter().map(|s| s.patches.len()).collect();
+        assert_eq!(listed.iter().sum::<usize>(), 2);
+        assert_eq!((listed[0], listed[20]), (1, 1));
+        let directions: Vec<Vec3> = mesh.patches.iter().map(|p| p.normal).collect();
+        assert!(directions.iter().any(|n| (*n - Vec3::NEG_Y).length() < 1e-5) && directions.iter().any(|n| (n.z.abs() - 1.0).abs() < 1e-5));
     }
 }

@@ -66,7 +66,9 @@ pub fn run(args: &RenderArgs, panels: &PanelCatalog) -> Result<(), CliError> {
         return Err(CliError::failure("--eye and --target are the same point"));
     }
     if let Some(fov) = args.fov {
-        let base = view.unwrap_or_else(|| crate::render::initial_view(&scene));
+        let base = view.unwrap_or_else(|| {
+            crate::render::initial_view(&scene, Some(&crate::light::LightModel::unlit(std::sync::Arc::new(scene.clone()))))
+        });
         view = Some(Viewpoint { fov: fov as f32, ..base });
     }
     let image = crate::render::offscreen::render(OffscreenRequest {

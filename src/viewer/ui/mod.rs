@@ -26,11 +26,11 @@ use bevy::window::PrimaryWindow;
 use bevy_egui::egui::{self, LayerId, Ui, UiBuilder};
 use bevy_egui::{EguiContexts, EguiGlobalSettings, EguiPlugin, EguiPrimaryContextPass, PrimaryEguiContext};
 
-use super::ViewerSystems;
 use super::camera::CameraControl;
 use super::focus::PanelFocus;
 use super::widgets::Note;
 use crate::render::{PictureCamera, RenderSettings};
+use crate::viewer::schedule::ViewerSystems;
 use materials::{MaterialEdits, MaterialPanel};
 use sensors::SensorPanel;
 use sun_and_sky::{PlayDay, SunAndSkyPanel};

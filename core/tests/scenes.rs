@@ -2,13 +2,13 @@
 //! their generator and every kind of bad input (the command line is tested
 //! in app/tests/cli.rs).
 
-#[path = "support/fixture.rs"]
+#[path = "../../tests/support/fixture.rs"]
 mod fixture;
 
 use std::path::Path;
 
-use heliodon::panel::PanelCatalog;
-use heliodon::scene::{LoadedScene, MaterialKind, SceneError, load_scene};
+use heliodon_core::panel::PanelCatalog;
+use heliodon_core::scene::{LoadedScene, MaterialKind, SceneError, load_scene};
 
 use fixture::{Fixture, OBJ, SITE, fixture, scene_toml};
 
@@ -17,7 +17,7 @@ fn no_panels() -> PanelCatalog {
 }
 
 fn bundled(name: &str) -> LoadedScene {
-    load_scene(&heliodon::bundled_scene(name), &no_panels()).unwrap_or_else(|e| panic!("{name}: {e}"))
+    load_scene(&heliodon_core::bundled_scene(name), &no_panels()).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 fn kinds(loaded: &LoadedScene) -> (usize, usize, usize) {

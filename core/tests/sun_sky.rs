@@ -4,16 +4,16 @@
 
 use std::f64::consts::PI;
 
-use heliodon::site::Site;
-use heliodon::sky::{Sky, SkyInputs, SkyPatches, SkySpec, integrate_hemisphere, perez};
-use heliodon::sun::{direction_from_angles, solar_position};
-use heliodon::time::{Date, LocalDateTime, TimeOfDay};
+use heliodon_core::site::Site;
+use heliodon_core::sky::{Sky, SkyInputs, SkyPatches, SkySpec, integrate_hemisphere, perez};
+use heliodon_core::sun::{direction_from_angles, solar_position};
+use heliodon_core::time::{Date, LocalDateTime, TimeOfDay};
 
 // ---- sun ----------------------------------------------------------------------
 
 #[test]
 fn spa_agrees_with_pvlib_on_80_untuned_cases() {
-    let text = include_str!("fixtures/spa_pvlib.csv");
+    let text = include_str!("../../tests/fixtures/spa_pvlib.csv");
     let mut worst: (f64, String) = (0.0, String::new());
     let mut count = 0;
     for line in text.lines().skip(1) {
@@ -144,7 +144,7 @@ fn gensky_sky_function_at_a_point() {
 #[test]
 fn integrated_horizontal_irradiance_matches_radiance() {
     let mut worst = (0.0f64, String::new());
-    for line in include_str!("fixtures/sky_rtrace.csv").lines().skip(1) {
+    for line in include_str!("../../tests/fixtures/sky_rtrace.csv").lines().skip(1) {
         let f: Vec<&str> = line.split(',').collect();
         let num = |i: usize| f[i].parse::<f64>().unwrap();
         let (alt, dni, dhi, day, reference) = (num(1), num(2), num(3), num(4) as u32, num(5));

@@ -2,32 +2,35 @@
 //! copied from ../shared/validation into tests/fixtures/sideroom), and its
 //! physical and numerical promises.
 
+#[path = "../../tests/support/quad_obj.rs"]
+mod quad_obj;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use heliodon::light::{LightModel, LightSettings};
-use heliodon::panel::PanelCatalog;
-use heliodon::scene::{Scene, load_scene};
-use heliodon::sky::{Sky, SkySpec, integrate_hemisphere};
-use heliodon::time::{Date, LocalDateTime, TimeOfDay};
+use heliodon_core::light::{LightModel, LightSettings};
+use heliodon_core::panel::PanelCatalog;
+use heliodon_core::scene::{Scene, load_scene};
+use heliodon_core::sky::{Sky, SkySpec, integrate_hemisphere};
+use heliodon_core::time::{Date, LocalDateTime, TimeOfDay};
 
 fn load(path: &Path) -> Arc<Scene> {
     Arc::new(load_scene(path, &PanelCatalog::new()).unwrap().scene)
 }
 
 fn sideroom() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/sideroom/scene.toml")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/sideroom/scene.toml")
 }
 
 fn sky_at(scene: &Scene, spec: &SkySpec, date: &str, time: &str) -> Sky {
     let when = LocalDateTime { date: Date::parse(date).unwrap(), time: TimeOfDay::parse(time).unwrap() };
-    heliodon::sky::sky_at(&scene.site, spec, &when).1.unwrap()
+    heliodon_core::sky::sky_at(&scene.site, spec, &when).1.unwrap()
 }
 
 #[test]
 fn validation_room_agrees_with_radiance() {
-    let references: HashMap<(String, String, String, String), f64> = include_str!("fixtures/sideroom/radiance.csv")
+    let references: HashMap<(String, String, String, String), f64> = include_str!("../../tests/fixtures/sideroom/radiance.csv")
         .lines()
         .skip(1)
         .map(|l| {
@@ -122,7 +125,7 @@ fn turning_north_on_the_site_matches_turning_the_model_in_its_file() {
 /// copy leaves the other panes lighting the room.
 #[test]
 fn windows_given_their_own_material_change_alone() {
-    use heliodon::scene::MaterialKind;
+    use heliodon_core::scene::MaterialKind;
     let scene = load(&sideroom());
     let sky = sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "12:00");
     let solve = |scene: Scene| LightModel::precompute(Arc::new(scene), quick()).unwrap().solve(&sky, None).sensors;
@@ -141,7 +144,7 @@ fn windows_given_their_own_material_change_alone() {
     }
     split.materials[own as usize].kind = MaterialKind::Glass { transmittance: 0.0 };
     let closed = solve(split);
-    let sky_of = |readings: &[heliodon::light::SensorReading]| readings.iter().map(|r| r.direct_sky).sum::<f64>();
+    let sky_of = |readings: &[heliodon_core::light::SensorReading]| readings.iter().map(|r| r.direct_sky).sum::<f64>();
     let share = sky_of(&closed) / sky_of(&before);
     println!("three of six panes closed: {:.1}% of the direct sky left", 100.0 * share);
     assert!((0.2..0.8).contains(&share), "{share}");
@@ -154,7 +157,7 @@ fn quick() -> LightSettings {
 
 #[test]
 fn results_do_not_depend_on_the_thread_count() {
-    let scene = load(&heliodon::bundled_scene("test_room"));
+    let scene = load(&heliodon_core::bundled_scene("test_room"));
     let sky = sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-03-21", "10:00");
     let one = LightModel::precompute(scene.clone(), LightSettings { threads: Some(1), ..quick() }).unwrap().solve(&sky, None);
     let three = LightModel::precompute(scene.clone(), LightSettings { threads: Some(3), ..quick() }).unwrap().solve(&sky, None);
@@ -278,7 +281,7 @@ fn settings_that_cannot_work_are_refused() {
 
 #[test]
 fn the_cache_is_used_and_never_trusted_when_damaged() {
-    use heliodon::light::cache::{CacheOutcome, precompute_cached};
+    use heliodon_core::light::cache::{CacheOutcome, precompute_cached};
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_cache");
     let _ = std::fs::remove_dir_all(&dir);
     let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_cache_scene");
@@ -335,17 +338,88 @@ fn open_models_and_sensors_inside_solids_are_handled() {
     let lighting = model.solve(&sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "12:00"), None);
     assert!(lighting.sensors.iter().all(|r| r.total.is_finite() && r.total > 0.0));
     // A sensor inside the test room's closed desk-like box is flagged.
-    let office = load(&heliodon::bundled_scene("office"));
+    let office = load(&heliodon_core::bundled_scene("office"));
     assert!(LightModel::precompute(office, quick()).unwrap().sensors_inside_solids().is_empty());
     let inside = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_inside");
     std::fs::create_dir_all(&inside).unwrap();
-    let scene_text = std::fs::read_to_string(heliodon::bundled_scene("office")).unwrap()
+    let scene_text = std::fs::read_to_string(heliodon_core::bundled_scene("office")).unwrap()
         + "\n[[sensors]]\nname = \"in-partition\"\nposition = [4.0, 4.0, 0.6]\nnormal = [0.0, 0.0, 1.0]\n";
     std::fs::write(inside.join("scene.toml"), scene_text).unwrap();
     for f in ["model.obj", "model.mtl"] {
-        std::fs::copy(heliodon::bundled_scene("office").with_file_name(f), inside.join(f)).unwrap();
+        std::fs::copy(heliodon_core::bundled_scene("office").with_file_name(f), inside.join(f)).unwrap();
     }
     let scene = load(&inside.join("scene.toml"));
     let flagged = LightModel::precompute(scene.clone(), quick()).unwrap().sensors_inside_solids();
     assert_eq!(flagged.iter().map(|&i| scene.sensors[i].name.as_str()).collect::<Vec<_>>(), ["in-partition"]);
+}
+
+/// A 4 × 6 × 3 m room with a 2 × 1.4 m south window and a grid of desk
+/// sensors, on a ground `width` × `depth` m centred on it (10 cm below its
+/// floor), as real exports come: `adaptive = false` cuts every surface
+/// into `patch_size` patches.
+fn room_on_a_ground(name: &str, width: f64, depth: f64, adaptive: bool) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("ground_{name}"));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut obj = quad_obj::QuadObj::new("room.mtl");
+    let (w, d, h) = (4.0, 6.0, 3.0);
+    obj.quad(
+        "ground",
+        [
+            [2.0 - width / 2.0, 3.0 - depth / 2.0, -0.1],
+            [2.0 + width / 2.0, 3.0 - depth / 2.0, -0.1],
+            [2.0 + width / 2.0, 3.0 + depth / 2.0, -0.1],
+            [2.0 - width / 2.0, 3.0 + depth / 2.0, -0.1],
+        ],
+    );
+    obj.quad("floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
+    obj.quad("ceiling", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
+    obj.quad("wall", [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]]);
+    obj.quad("wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
+    obj.quad("wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
+    obj.quad("wall", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, 0.0, 0.9], [0.0, 0.0, 0.9]]);
+    obj.quad("wall", [[0.0, 0.0, 2.3], [w, 0.0, 2.3], [w, 0.0, h], [0.0, 0.0, h]]);
+    obj.quad("wall", [[0.0, 0.0, 0.9], [1.0, 0.0, 0.9], [1.0, 0.0, 2.3], [0.0, 0.0, 2.3]]);
+    obj.quad("wall", [[3.0, 0.0, 0.9], [w, 0.0, 0.9], [w, 0.0, 2.3], [3.0, 0.0, 2.3]]);
+    obj.quad("glass", [[1.0, 0.0, 0.9], [3.0, 0.0, 0.9], [3.0, 0.0, 2.3], [1.0, 0.0, 2.3]]);
+    std::fs::write(dir.join("room.obj"), obj.text()).unwrap();
+    let mtl = "newmtl ground\nKd 0.2 0.2 0.2\nnewmtl floor\nKd 0.3 0.3 0.3\nnewmtl ceiling\nKd 0.8 0.8 0.8\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.12\n";
+    std::fs::write(dir.join("room.mtl"), mtl).unwrap();
+    let lighting = if adaptive { "" } else { "[lighting]\nadaptive = false\n" };
+    let scene = format!(
+        "name = \"Room on a ground\"\n[site]\nlatitude = 40.78\nlongitude = -73.97\ntimezone = -5.0\n{lighting}[model]\nobj = \"room.obj\"\n\n[[sensor_grids]]\nname = \"desks\"\nmin = [0.5, 0.5]\nmax = [3.5, 5.5]\nheight = 0.8\nspacing = 1.0\n"
+    );
+    std::fs::write(dir.join("scene.toml"), scene).unwrap();
+    dir.join("scene.toml")
+}
+
+/// Patches follow the light, not the area: a room on a 400 × 300 m ground
+/// (the Radiance tutorial room's case) needs a few thousand patches, and
+/// its light is the light of the same room with `patch_size` patches
+/// everywhere (on a ground small enough to afford them).
+#[test]
+fn patches_are_fine_around_the_room_and_coarse_on_a_far_ground() {
+    let site = load(&room_on_a_ground("site", 400.0, 300.0, true));
+    let patches = site.patches.patches.len();
+    // The room's own surfaces at 0.5 m are about 500 patches; the ground 120,000 m².
+    assert!(patches < 5_000, "{patches} patches");
+    let ground_patches = site.patches.patches.iter().filter(|p| site.materials[p.material as usize].name == "ground").count();
+    let ground_area: f32 =
+        site.patches.patches.iter().filter(|p| site.materials[p.material as usize].name == "ground").map(|p| p.area).sum();
+    assert!((ground_area - 120_000.0).abs() < 1.0, "the coarse patches still cover the ground: {ground_area} m²");
+    println!("400 × 300 m ground: {patches} patches, {ground_patches} on the ground");
+    let adaptive = load(&room_on_a_ground("adaptive", 60.0, 40.0, true));
+    let uniform = load(&room_on_a_ground("uniform", 60.0, 40.0, false));
+    assert!(adaptive.patches.patches.len() * 3 < uniform.patches.patches.len());
+    for (spec, time) in [(SkySpec::Overcast, "12:00"), (SkySpec::Clear { turbidity: 2.45 }, "15:00")] {
+        let light = |scene: &Arc<Scene>| {
+            let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
+            model.solve(&sky_at(scene, &spec, "2026-03-21", time), None).sensors
+        };
+        let (a, u) = (light(&adaptive), light(&uniform));
+        let mut errors: Vec<f64> = a.iter().zip(&u).map(|(a, u)| (a.total - u.total).abs() / u.total).collect();
+        errors.sort_by(f64::total_cmp);
+        let (median, max) = (errors[errors.len() / 2], errors[errors.len() - 1]);
+        println!("{spec:?} {time}: adaptive vs uniform patches, median {:.2}%, max {:.2}%", 100.0 * median, 100.0 * max);
+        assert!(median < 0.01 && max < 0.03, "median {median}, max {max}");
+    }
 }
