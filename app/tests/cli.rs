@@ -237,6 +237,39 @@ fn sensors_command_prints_the_contract_csv_and_shares_one_precomputation() {
     assert!(rows[1].starts_with("2026-03-21,09:00:00,s00,") && rows[rows.len() - 1].starts_with("2026-06-21,12:00:00,ceiling_centre,"));
 }
 
+/// A sensor outside every room, and a model with no room at all, are named
+/// in one warning line; the command still answers.
+#[test]
+fn sensors_in_the_open_are_warned_about() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sensor_outside");
+    std::fs::create_dir_all(&dir).unwrap();
+    let room = bundled_scene("test_room");
+    for file in ["model.obj", "model.mtl"] {
+        std::fs::copy(room.with_file_name(file), dir.join(file)).unwrap();
+    }
+    let text = std::fs::read_to_string(&room).unwrap()
+        + "\n[[sensors]]\nname = \"in-the-garden\"\nposition = [2.0, -12.0, 0.8]\nnormal = [0.0, 0.0, 1.0]\n";
+    std::fs::write(dir.join("scene.toml"), text).unwrap();
+    let scene = dir.join("scene.toml");
+    let args = ["sensors", scene.to_str().unwrap(), "--date", "2026-03-21", "--time", "12:00", "--format", "csv"];
+    let Run { code, out, err } = heliodon(&args, &scratch());
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("in-the-garden,"), "it still reads: {out}");
+    let warnings: Vec<&str> = err.lines().filter(|l| l.contains("open sky")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(
+        warnings[0].contains("sensors outside every room") && warnings[0].ends_with("in-the-garden; they read the light where they are"),
+        "{err}"
+    );
+    // No room at all: a wall and a pane in the open.
+    let open =
+        fixture("open_model", &scene_toml("\n[[sensors]]\nname = \"s\"\nposition = [0.5, 0.5, 1.0]\nnormal = [0.0, 0.0, 1.0]\n"), OBJ);
+    let Run { code, err, .. } =
+        heliodon(&["sensors", open.scene().to_str().unwrap(), "--date", "2026-03-21", "--time", "12:00"], &scratch());
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("the model has no enclosed room around them"), "{err}");
+}
+
 #[test]
 fn sensors_command_rejects_bad_input_in_one_line() {
     let cache = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sensors_cli_cache_bad");

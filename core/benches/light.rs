@@ -4,6 +4,8 @@
 
 #[path = "../../tests/support/quad_obj.rs"]
 mod quad_obj;
+#[path = "../../tests/support/room_on_ground.rs"]
+mod room_on_ground;
 
 use quad_obj::QuadObj;
 use std::fmt::Write as _;
@@ -166,6 +168,18 @@ fn bench(c: &mut Criterion) {
             b.iter(|| relight(&model, &scene, &before, 10.0 + 1.0 / 6.0))
         });
     }
+    // A room on a 400 × 300 m ground (as Radiance's tutorial room stands).
+    let path = room_on_ground::room_on_a_ground(&std::env::temp_dir().join("heliodon-bench-room-on-ground"), 400.0, 300.0, true);
+    let scene = Arc::new(load_scene(&path, &PanelCatalog::new()).unwrap().scene);
+    let patches = scene.patches.patches.len();
+    group.bench_function(format!("precompute room on a 400 x 300 m ground ({patches} patches)"), |b| {
+        b.iter(|| LightModel::precompute(scene.clone(), LightSettings::default()).unwrap())
+    });
+    let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
+    let before = model.solve(&sky_at(&scene, 10.0), None);
+    group.bench_function("relight room on a 400 x 300 m ground (sun moves 10 min)", |b| {
+        b.iter(|| relight(&model, &scene, &before, 10.0 + 1.0 / 6.0))
+    });
     let path = large_building(&std::env::temp_dir().join("heliodon-bench-office-floor"), false);
     let scene = Arc::new(load_scene(&path, &PanelCatalog::new()).unwrap().scene);
     let patches = scene.patches.patches.len();

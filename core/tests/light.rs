@@ -4,6 +4,8 @@
 
 #[path = "../../tests/support/quad_obj.rs"]
 mod quad_obj;
+#[path = "../../tests/support/room_on_ground.rs"]
+mod room_on_ground;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -353,43 +355,9 @@ fn open_models_and_sensors_inside_solids_are_handled() {
     assert_eq!(flagged.iter().map(|&i| scene.sensors[i].name.as_str()).collect::<Vec<_>>(), ["in-partition"]);
 }
 
-/// A 4 × 6 × 3 m room with a 2 × 1.4 m south window and a grid of desk
-/// sensors, on a ground `width` × `depth` m centred on it (10 cm below its
-/// floor), as real exports come: `adaptive = false` cuts every surface
-/// into `patch_size` patches.
-fn room_on_a_ground(name: &str, width: f64, depth: f64, adaptive: bool) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("ground_{name}"));
-    std::fs::create_dir_all(&dir).unwrap();
-    let mut obj = quad_obj::QuadObj::new("room.mtl");
-    let (w, d, h) = (4.0, 6.0, 3.0);
-    obj.quad(
-        "ground",
-        [
-            [2.0 - width / 2.0, 3.0 - depth / 2.0, -0.1],
-            [2.0 + width / 2.0, 3.0 - depth / 2.0, -0.1],
-            [2.0 + width / 2.0, 3.0 + depth / 2.0, -0.1],
-            [2.0 - width / 2.0, 3.0 + depth / 2.0, -0.1],
-        ],
-    );
-    obj.quad("floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
-    obj.quad("ceiling", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
-    obj.quad("wall", [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]]);
-    obj.quad("wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
-    obj.quad("wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
-    obj.quad("wall", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, 0.0, 0.9], [0.0, 0.0, 0.9]]);
-    obj.quad("wall", [[0.0, 0.0, 2.3], [w, 0.0, 2.3], [w, 0.0, h], [0.0, 0.0, h]]);
-    obj.quad("wall", [[0.0, 0.0, 0.9], [1.0, 0.0, 0.9], [1.0, 0.0, 2.3], [0.0, 0.0, 2.3]]);
-    obj.quad("wall", [[3.0, 0.0, 0.9], [w, 0.0, 0.9], [w, 0.0, 2.3], [3.0, 0.0, 2.3]]);
-    obj.quad("glass", [[1.0, 0.0, 0.9], [3.0, 0.0, 0.9], [3.0, 0.0, 2.3], [1.0, 0.0, 2.3]]);
-    std::fs::write(dir.join("room.obj"), obj.text()).unwrap();
-    let mtl = "newmtl ground\nKd 0.2 0.2 0.2\nnewmtl floor\nKd 0.3 0.3 0.3\nnewmtl ceiling\nKd 0.8 0.8 0.8\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.12\n";
-    std::fs::write(dir.join("room.mtl"), mtl).unwrap();
-    let lighting = if adaptive { "" } else { "[lighting]\nadaptive = false\n" };
-    let scene = format!(
-        "name = \"Room on a ground\"\n[site]\nlatitude = 40.78\nlongitude = -73.97\ntimezone = -5.0\n{lighting}[model]\nobj = \"room.obj\"\n\n[[sensor_grids]]\nname = \"desks\"\nmin = [0.5, 0.5]\nmax = [3.5, 5.5]\nheight = 0.8\nspacing = 1.0\n"
-    );
-    std::fs::write(dir.join("scene.toml"), scene).unwrap();
-    dir.join("scene.toml")
+/// The room of `tests/support/room_on_ground.rs` in this test's folder `name`.
+fn on_a_ground(name: &str, width: f64, depth: f64, adaptive: bool) -> PathBuf {
+    room_on_ground::room_on_a_ground(&Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("ground_{name}")), width, depth, adaptive)
 }
 
 /// Patches follow the light, not the area: a room on a 400 × 300 m ground
@@ -398,7 +366,7 @@ fn room_on_a_ground(name: &str, width: f64, depth: f64, adaptive: bool) -> PathB
 /// everywhere (on a ground small enough to afford them).
 #[test]
 fn patches_are_fine_around_the_room_and_coarse_on_a_far_ground() {
-    let site = load(&room_on_a_ground("site", 400.0, 300.0, true));
+    let site = load(&on_a_ground("site", 400.0, 300.0, true));
     let patches = site.patches.patches.len();
     // The room's own surfaces at 0.5 m are about 500 patches; the ground 120,000 m².
     assert!(patches < 5_000, "{patches} patches");
@@ -407,8 +375,8 @@ fn patches_are_fine_around_the_room_and_coarse_on_a_far_ground() {
         site.patches.patches.iter().filter(|p| site.materials[p.material as usize].name == "ground").map(|p| p.area).sum();
     assert!((ground_area - 120_000.0).abs() < 1.0, "the coarse patches still cover the ground: {ground_area} m²");
     println!("400 × 300 m ground: {patches} patches, {ground_patches} on the ground");
-    let adaptive = load(&room_on_a_ground("adaptive", 60.0, 40.0, true));
-    let uniform = load(&room_on_a_ground("uniform", 60.0, 40.0, false));
+    let adaptive = load(&on_a_ground("adaptive", 60.0, 40.0, true));
+    let uniform = load(&on_a_ground("uniform", 60.0, 40.0, false));
     assert!(adaptive.patches.patches.len() * 3 < uniform.patches.patches.len());
     for (spec, time) in [(SkySpec::Overcast, "12:00"), (SkySpec::Clear { turbidity: 2.45 }, "15:00")] {
         let light = |scene: &Arc<Scene>| {
@@ -422,4 +390,53 @@ fn patches_are_fine_around_the_room_and_coarse_on_a_far_ground() {
         println!("{spec:?} {time}: adaptive vs uniform patches, median {:.2}%, max {:.2}%", 100.0 * median, 100.0 * max);
         assert!(median < 0.01 && max < 0.03, "median {median}, max {max}");
     }
+}
+
+/// A pane modelled as a glass box 2 cm thick (as BIM exports write them)
+/// is read as one pane, with one warning: one window, and the light of a
+/// single glass face, not of two (τ²).
+#[test]
+fn a_glass_box_is_read_as_one_pane() {
+    let scene_with = |name: &str, thick: bool| {
+        let path = on_a_ground(name, 10.0, 10.0, true);
+        if thick {
+            // The pane's far face (facing into the room, 2 cm in) and its four edges.
+            let mut obj = std::fs::read_to_string(path.with_file_name("room.obj")).unwrap();
+            let mut quads = quad_obj::QuadObj::new("room.mtl");
+            let (x0, x1, z0, z1, y) = (1.0, 3.0, 0.9, 2.3, 0.02);
+            quads.quad("glass", [[1.0, y, 0.9], [1.0, y, 2.3], [3.0, y, 2.3], [3.0, y, 0.9]]);
+            quads.quad("glass", [[x0, 0.0, z0], [x0, y, z0], [x1, y, z0], [x1, 0.0, z0]]);
+            quads.quad("glass", [[x0, 0.0, z1], [x1, 0.0, z1], [x1, y, z1], [x0, y, z1]]);
+            quads.quad("glass", [[x0, 0.0, z0], [x0, 0.0, z1], [x0, y, z1], [x0, y, z0]]);
+            quads.quad("glass", [[x1, 0.0, z0], [x1, y, z0], [x1, y, z1], [x1, 0.0, z1]]);
+            // Appended after the room's vertices: renumber the new faces.
+            let offset = obj.lines().filter(|l| l.starts_with("v ")).count();
+            for line in quads.text().lines().skip(1) {
+                let line = match line.strip_prefix("f ") {
+                    Some(f) => format!(
+                        "f {}",
+                        f.split(' ').map(|i| (i.parse::<usize>().unwrap() + offset).to_string()).collect::<Vec<_>>().join(" ")
+                    ),
+                    None => line.to_string(),
+                };
+                obj.push_str(&line);
+                obj.push('\n');
+            }
+            std::fs::write(path.with_file_name("room.obj"), obj).unwrap();
+        }
+        load_scene(&path, &PanelCatalog::new()).unwrap()
+    };
+    let (thin, thick) = (scene_with("thin_pane", false), scene_with("thick_pane", true));
+    assert!(thin.warnings.is_empty(), "{:?}", thin.warnings);
+    assert_eq!(thick.warnings.len(), 1, "{:?}", thick.warnings);
+    assert!(thick.warnings[0].message.starts_with("1 glass panes are modelled as boxes"), "{}", thick.warnings[0]);
+    assert_eq!(thick.scene.windows.len(), 1);
+    assert!((thick.scene.windows[0].area - 2.8).abs() < 1e-4);
+    let sky = |scene: &Scene| {
+        let scene = Arc::new(scene.clone());
+        let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
+        model.solve(&sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "12:00"), None).sensors.iter().map(|r| r.direct_sky).sum::<f64>()
+    };
+    let (one, box_pane) = (sky(&thin.scene), sky(&thick.scene));
+    assert!((box_pane - one).abs() < 0.02 * one, "a box pane passes {box_pane} lx of sky, one face {one} lx");
 }

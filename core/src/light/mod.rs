@@ -228,6 +228,24 @@ impl LightModel {
         self.group_of_surface[surface as usize]
     }
 
+    /// Each sensor's share of its hemisphere (cosine-weighted) that sees the
+    /// open sky or ground directly, through no window: near 0 in a room,
+    /// 1 in the open. A sensor with much of it stands outside every room.
+    pub fn open_sky_shares(&self) -> Vec<f64> {
+        let bins = self.bin_count();
+        self.sensors
+            .iter()
+            .map(|s| {
+                s.gather
+                    .daylight_coefficients
+                    .iter()
+                    .filter(|&&(k, _)| SkyKey::unpack(k, bins).window.is_none())
+                    .map(|&(_, w)| f64::from(w))
+                    .sum()
+            })
+            .collect()
+    }
+
     /// Sensors that seem to sit inside a solid: every ray from them meets a
     /// surface from its back, within a few metres. They still read what
     /// reaches them; the caller warns.

@@ -12,6 +12,7 @@ mod frame;
 mod material;
 mod obj;
 mod patches;
+mod repair;
 pub(crate) use patches::clip as clip_convex;
 mod sensors;
 mod surfaces;
@@ -225,7 +226,25 @@ fn build(
     let model = obj::import(&obj_path, obj_text, &obj_scan, &mtls)?;
     let (materials, material_of) = material::resolve(&parsed, &model, panels, &obj_path, &mut warnings)?;
     let raw_triangles = obj::triangles(&model, &parsed.frame, &material_of, &obj_path, &mut warnings)?;
-    let (triangles, mut surfaces) = surfaces::group(raw_triangles);
+    let (mut triangles, mut surfaces) = surfaces::group(raw_triangles);
+    let (box_faces, panes) = repair::thick_glass(&triangles, &surfaces, &materials);
+    if panes > 0 {
+        warnings.push(SceneWarning {
+            location: Location::file(&obj_path),
+            message: format!(
+                "{panes} glass panes are modelled as boxes (two faces up to {} cm apart): each is read as one pane, its far face and edges dropped ({} surfaces)",
+                repair::MAX_PANE_THICKNESS * 100.0,
+                box_faces.len()
+            ),
+        });
+        let keep: Vec<Triangle> = surfaces
+            .iter()
+            .enumerate()
+            .filter(|(index, _)| box_faces.binary_search(&(*index as u32)).is_err())
+            .flat_map(|(_, s)| triangles[s.triangles.start as usize..s.triangles.end as usize].iter().copied())
+            .collect();
+        (triangles, surfaces) = surfaces::group(keep);
+    }
     let windows = surfaces::windows(&triangles, &surfaces, &materials);
     let sensors = sensors::sensors(&parsed)?;
     // Patches are finest around the windows and the sensors (see `patches`).

@@ -45,6 +45,20 @@ pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, Stri
         progress.set_position((done * 1000.0) as u64)
     })?;
     progress.finish_and_clear();
+    // Sensors in the open: outside every room, or a model without one.
+    const OUTSIDE: f64 = 0.3;
+    let outside: Vec<&str> =
+        model.open_sky_shares().iter().zip(&scene.sensors).filter(|(share, _)| **share > OUTSIDE).map(|(_, s)| s.name.as_str()).collect();
+    if !outside.is_empty() {
+        let named = outside.iter().take(5).copied().collect::<Vec<_>>().join(", ");
+        let more = if outside.len() > 5 { format!(" and {} more", outside.len() - 5) } else { String::new() };
+        let what = if outside.len() == scene.sensors.len() {
+            "every sensor sees the open sky directly: the model has no enclosed room around them"
+        } else {
+            "sensors outside every room (they see the open sky directly)"
+        };
+        eprintln!("warning: {}: {what}: {named}{more}; they read the light where they are", args.scene.display());
+    }
     for i in model.sensors_inside_solids() {
         eprintln!(
             "warning: {}: sensor '{}' seems to be inside a solid (every direction meets a back face); it reads what reaches it there",

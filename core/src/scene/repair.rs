@@ -1,0 +1,98 @@
+//! What real exports need before their light is right, each found problem
+//! reported in one warning line.
+//!
+//! - **Thick glass.** BIM exports model a pane as a glass box (two faces
+//!   a couple of centimetres apart and four thin edges). Read as it is, light
+//!   would cross glass twice (τ²) and the edges would count as windows. A
+//!   pair of parallel glass faces of one material, facing apart, of about
+//!   the same area and no more than [`MAX_PANE_THICKNESS`] apart is one pane:
+//!   the face that sees more of the outside is kept (either works: the
+//!   windows' outward side is ray-tested later), the other and the glass
+//!   edges between them are dropped.
+
+use std::collections::HashMap;
+
+use glam::Vec3;
+
+use super::material::Material;
+use super::{Surface, Triangle};
+
+/// Glass faces closer than this (m) are the two sides of one pane.
+pub const MAX_PANE_THICKNESS: f32 = 0.06;
+
+/// Surfaces that are the far side or the edges of a glass pane modelled as
+/// a box (indices into `surfaces`), and how many panes were found.
+pub fn thick_glass(triangles: &[Triangle], surfaces: &[Surface], materials: &[Material]) -> (Vec<u32>, usize) {
+    let glass: Vec<usize> = (0..surfaces.len()).filter(|&s| materials[surfaces[s].material as usize].kind.transmits()).collect();
+    let tris = |s: usize| &triangles[surfaces[s].triangles.start as usize..surfaces[s].triangles.end as usize];
+    let centroid = |s: usize| tris(s).iter().map(|t| t.centroid() * t.area()).sum::<Vec3>() / surfaces[s].area.max(f32::MIN_POSITIVE);
+    let centres: HashMap<usize, Vec3> = glass.iter().map(|&s| (s, centroid(s))).collect();
+    // Glass surfaces by the cell of their centre, for neighbours in near-linear time.
+    let cell = |p: Vec3| (p / (2.0 * MAX_PANE_THICKNESS)).floor().as_ivec3().to_array();
+    let mut grid: HashMap<[i32; 3], Vec<usize>> = HashMap::new();
+    for &s in &glass {
+        grid.entry(cell(centres[&s])).or_default().push(s);
+    }
+    let mut dropped = vec![false; surfaces.len()];
+    let mut panes = Vec::new();
+    for &s in &glass {
+        if dropped[s] {
+            continue;
+        }
+        let (a, n, c) = (&surfaces[s], surfaces[s].normal, centres[&s]);
+        let [x, y, z] = cell(c);
+        let partner = (-1..=1)
+            .flat_map(|dx| (-1..=1).flat_map(move |dy| (-1..=1).map(move |dz| [x + dx, y + dy, z + dz])))
+            .filter_map(|k| grid.get(&k))
+            .flatten()
+            .copied()
+            .find(|&t| {
+                let b = &surfaces[t];
+                let gap = (centres[&t] - c).dot(n).abs();
+                let beside = (centres[&t] - c) - n * (centres[&t] - c).dot(n);
+                t != s
+                    && !dropped[t]
+                    && b.material == a.material
+                    && b.normal.dot(n) < -0.999
+                    && gap > 1e-4
+                    && gap <= MAX_PANE_THICKNESS
+                    && beside.length() <= MAX_PANE_THICKNESS
+                    && (a.area - b.area).abs() <= 0.1 * a.area.max(b.area)
+            });
+        if let Some(t) = partner {
+            dropped[t] = true;
+            panes.push((s, t));
+        }
+    }
+    // The box's edges: glass lying within a pane's slab and footprint
+    // (found through a metre grid of the glass surfaces' centres).
+    let metre = |p: Vec3| p.floor().as_ivec3();
+    let mut coarse: HashMap<[i32; 3], Vec<usize>> = HashMap::new();
+    for &s in &glass {
+        coarse.entry(metre(centres[&s]).to_array()).or_default().push(s);
+    }
+    for &(s, t) in &panes {
+        let (n, c) = (surfaces[s].normal, centres[&s]);
+        let gap = (centres[&t] - c).dot(n);
+        let (lo, hi) = tris(s).iter().flat_map(|t| t.vertices).fold((Vec3::MAX, Vec3::MIN), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        let (lo, hi) = (lo - Vec3::splat(MAX_PANE_THICKNESS), hi + Vec3::splat(MAX_PANE_THICKNESS));
+        let (first, last) = (metre(lo), metre(hi));
+        for x in first.x..=last.x {
+            for y in first.y..=last.y {
+                for z in first.z..=last.z {
+                    for &e in coarse.get(&[x, y, z]).into_iter().flatten() {
+                        if dropped[e] || e == s || surfaces[e].material != surfaces[s].material || surfaces[e].normal.dot(n).abs() > 0.1 {
+                            continue;
+                        }
+                        let within = tris(e).iter().flat_map(|t| t.vertices).all(|v| {
+                            let along = (v - c).dot(n);
+                            along >= gap.min(0.0) - 1e-4 && along <= gap.max(0.0) + 1e-4 && v.cmpge(lo).all() && v.cmple(hi).all()
+                        });
+                        dropped[e] |= within;
+                    }
+                }
+            }
+        }
+    }
+    ((0..surfaces.len() as u32).filter(|&s| dropped[s as usize]).collect(), panes.len())
+}
