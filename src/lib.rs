@@ -14,7 +14,7 @@ pub mod ecs;
 pub mod render;
 pub mod viewer;
 
-pub use heliodon_core::{BUNDLED_SCENES, bundled_scene, day, light, panel, radiance, scene, site, sky, sun, sun_pass, time};
+pub use heliodon_core::{BUNDLED_SCENES, bundled_scene, day, light, panel, radiance, report, scene, site, sky, sun, sun_pass, time};
 
 use bevy::asset::{AssetMetaCheck, AssetPlugin, UnapprovedPathMode};
 

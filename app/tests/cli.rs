@@ -270,6 +270,41 @@ fn sensors_in_the_open_are_warned_about() {
     assert!(err.contains("the model has no enclosed room around them"), "{err}");
 }
 
+/// Names with commas, quotes, line breaks and control characters leave
+/// the CSV (RFC 4180), the JSON and the Radiance export valid.
+#[test]
+fn odd_sensor_names_keep_every_output_valid() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("odd_names");
+    std::fs::create_dir_all(&dir).unwrap();
+    let room = bundled_scene("test_room");
+    for file in ["model.obj", "model.mtl"] {
+        std::fs::copy(room.with_file_name(file), dir.join(file)).unwrap();
+    }
+    let sensor = |name: &str| format!("\n[[sensors]]\nname = \"{name}\"\nposition = [2.0, 3.0, 0.8]\nnormal = [0.0, 0.0, 1.0]\n");
+    let text = std::fs::read_to_string(&room).unwrap() + &sensor(r#"desk, \"north\""#) + &sensor(r"two\nlines") + &sensor(r"bell\u0007");
+    std::fs::write(dir.join("scene.toml"), text).unwrap();
+    let scene = dir.join("scene.toml");
+    let case = ["--date", "2026-03-21", "--time", "12:00", "--sky", "overcast"];
+    let run = |format: &str| heliodon(&[&["sensors", scene.to_str().unwrap()], &case[..], &["--format", format]].concat(), &scratch());
+    let Run { code, out, err } = run("csv");
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("\n\"desk, \"\"north\"\"\","), "{out}");
+    assert!(out.contains("\n\"two\nlines\","), "{out}");
+    assert!(out.contains("\nbell\u{7},"), "{out}");
+    let Run { out, .. } = run("json");
+    assert!(out.contains(r#""name": "desk, \"north\"""#) && out.contains(r#""name": "two\nlines""#), "{out}");
+    assert!(out.contains(r#""name": "bell\u0007""#) && !out.contains('\u{7}'), "{out}");
+    let export = dir.join("export");
+    let Run { code, err, .. } =
+        heliodon(&[&["export-radiance", scene.to_str().unwrap()], &case[..], &["--out", export.to_str().unwrap()]].concat(), &scratch());
+    assert_eq!(code, 0, "{err}");
+    let index = std::fs::read_to_string(export.join("sensors.txt")).unwrap();
+    assert!(index.lines().all(|l| l.split(' ').count() == 2), "one word and a count a line: {index}");
+    let names = std::fs::read_to_string(export.join("names.csv")).unwrap();
+    assert_eq!(names.lines().count(), index.lines().count());
+    assert!(names.contains("\"desk, \"\"north\"\"\"\n") && names.contains("two lines\n"), "{names}");
+}
+
 #[test]
 fn sensors_command_rejects_bad_input_in_one_line() {
     let cache = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sensors_cli_cache_bad");

@@ -11,7 +11,8 @@
 //!   radiosity, direct sun and panel beams, the cache), and [`day`] (a
 //!   sensor's day and year);
 //! - what the renderer's stencil pass draws: [`sun_pass`];
-//! - the Radiance export: [`radiance`].
+//! - the Radiance export: [`radiance`]; CSV and JSON that stay valid
+//!   whatever the names: [`report`].
 //!
 //! The Bevy layer (the `heliodon` crate: ECS, renderer, viewer, CLI) is
 //! built on this crate; panel crates need only this one ([`prelude`]).
@@ -22,6 +23,7 @@ pub mod day;
 pub mod light;
 pub mod panel;
 pub mod radiance;
+pub mod report;
 pub mod scene;
 pub mod site;
 pub mod sky;

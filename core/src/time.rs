@@ -143,6 +143,10 @@ impl TimeOfDay {
         if minutes >= 60 || seconds >= 60.0 {
             return Err(format!("'{text}' is not a time: minutes and seconds run 0-59"));
         }
+        // Checked before any arithmetic: a huge hour count must not wrap into the day.
+        if hours > 24 {
+            return Err(format!("'{text}' is outside 00:00-24:00"));
+        }
         let total = f64::from(hours * 3600 + minutes * 60) + seconds;
         if total > Self::SECONDS_PER_DAY {
             return Err(format!("'{text}' is outside 00:00-24:00"));
@@ -218,6 +222,9 @@ mod tests {
         assert_eq!(TimeOfDay::parse("24:00").unwrap().hours(), 24.0);
         assert!(TimeOfDay::parse("24:01").is_err());
         assert!(TimeOfDay::parse("25:00").is_err());
+        // An hour count whose seconds overflow 32 bits does not wrap into the day.
+        assert!(TimeOfDay::parse("4294967:00").unwrap_err().contains("outside 00:00-24:00"));
+        assert!(TimeOfDay::parse("1193047:00").is_err());
         assert!(TimeOfDay::parse("12:60").is_err());
         assert!(TimeOfDay::parse("12").is_err());
         assert!(TimeOfDay::parse("-1:00").is_err());

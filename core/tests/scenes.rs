@@ -228,6 +228,35 @@ fn material_values_are_checked() {
     assert!(e.message.contains("'brick'"), "{e}");
 }
 
+/// MTL statements with too few numbers (tobj 4 panics on `Ks 0`), or a
+/// dissolve outside 0-1 (which would silently make windows black), are one
+/// error naming the MTL line, even when the scene file overrides the
+/// material; a byte-order mark at the start of a file is read past.
+#[test]
+fn malformed_mtl_statements_are_one_line() {
+    let mtl_with = |extra: &str| format!("newmtl wall\nKd 0.5 0.5 0.5\n{extra}\nnewmtl glass\nd 0.12\n");
+    let cases = [
+        ("Ks 0", "Ks needs 3 numbers, not 1"),
+        ("Kd 0.5 x 0.5", "Kd needs 3 finite numbers"),
+        ("d 1.5", "d 1.5 is outside 0-1"),
+        ("Tr -0.2", "Tr -0.2 is outside 0-1"),
+        ("Ns", "Ns needs 1 number, not 0"),
+    ];
+    for (k, (statement, expected)) in cases.iter().enumerate() {
+        let toml = scene_toml("\n[materials.wall]\nkind = \"diffuse\"\nreflectance = 0.5\n");
+        let f = Fixture::new(&format!("mtl_{k}"), &[("scene.toml", &toml), ("room.obj", OBJ), ("room.mtl", &mtl_with(statement))]);
+        let e = f.error();
+        assert_eq!((e.location.file.clone(), e.location.line), (f.dir.join("room.mtl"), Some(3)), "{statement}: {e}");
+        assert!(e.message.contains(expected), "{statement}: {e}");
+    }
+    let bom = Fixture::new(
+        "bom",
+        &[("scene.toml", &scene_toml("")), ("room.obj", &format!("\u{feff}{OBJ}")), ("room.mtl", &format!("\u{feff}{}", mtl_with("")))],
+    );
+    let loaded = bom.load().unwrap();
+    assert_eq!(loaded.scene.windows.len(), 1);
+}
+
 #[test]
 fn unused_scene_material_is_a_warning() {
     let f = fixture("unused", &scene_toml("\n[materials.marble]\nkind = \"diffuse\"\nreflectance = 0.7\n"), OBJ);
@@ -260,6 +289,17 @@ fn non_finite_coordinates() {
     let f = fixture("nan_sensor", &scene_toml(sensor), OBJ);
     let e = f.error();
     assert_eq!((e.location.line, e.location.key.as_deref()), (Some(12), Some("sensors[0].position")), "{e}");
+    // Finite in f64 but past what f32 keeps: refused, not read as infinity.
+    let f = fixture("huge", &scene_toml(""), &OBJ.replace("v 1 0 0", "v 1e39 0 0"));
+    let e = f.error();
+    assert!(e.location.line == Some(3) && e.message.contains("beyond ±1e9"), "{e}");
+    let sensor = "\n[[sensors]]\nname = \"s\"\nposition = [0.5, 1e39, 0.8]\nnormal = [0.0, 0.0, 1.0]\n";
+    let e = fixture("huge_sensor", &scene_toml(sensor), OBJ).error();
+    assert_eq!(e.location.key.as_deref(), Some("sensors[0].position"), "{e}");
+    // A normal of enormous length is a direction like any other.
+    let sensor = "\n[[sensors]]\nname = \"s\"\nposition = [0.5, 0.5, 0.8]\nnormal = [0.0, 0.0, 1e300]\n";
+    let loaded = fixture("long_normal", &scene_toml(sensor), OBJ).load().unwrap();
+    assert!((loaded.scene.sensors[0].normal - glam::Vec3::Z).length() < 1e-6, "{:?}", loaded.scene.sensors[0].normal);
 }
 
 #[test]

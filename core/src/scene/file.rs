@@ -8,9 +8,9 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::DEFAULT_PATCH_SIZE;
 use super::error::{Location, SceneError};
 use super::frame::{ModelFrame, UpAxis};
+use super::{DEFAULT_PATCH_SIZE, MAX_COORDINATE};
 use crate::site::Site;
 
 #[derive(Debug, Deserialize)]
@@ -145,6 +145,15 @@ impl ParsedScene {
         let v = *value.get_ref();
         if v.iter().any(|c| !c.is_finite()) {
             return self.error(value.span(), key, "coordinates must be finite numbers");
+        }
+        Ok(v)
+    }
+
+    /// [`Self::finite`] for a position: also within ±[`MAX_COORDINATE`].
+    pub fn position<const N: usize>(&self, value: &Spanned<[f64; N]>, key: &str) -> Result<[f64; N], SceneError> {
+        let v = self.finite(value, key)?;
+        if let Some(c) = v.iter().find(|c| c.abs() > MAX_COORDINATE) {
+            return self.error(value.span(), key, format!("{c:e} is beyond ±{MAX_COORDINATE:e} model units"));
         }
         Ok(v)
     }

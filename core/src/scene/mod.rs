@@ -12,6 +12,7 @@ mod frame;
 mod material;
 mod obj;
 mod patches;
+mod polygon;
 mod repair;
 pub(crate) use patches::clip as clip_convex;
 mod sensors;
@@ -32,6 +33,11 @@ pub use sensors::{DEFAULT_FOV, Sensor, Viewpoint};
 
 use crate::panel::PanelCatalog;
 use crate::site::Site;
+
+/// The largest coordinate (model units) heliodon reads: beyond it f32 loses
+/// the model (1e9 m is 6 times the Earth–Sun distance; survey coordinates of
+/// a few hundred km are well inside).
+pub const MAX_COORDINATE: f64 = 1e9;
 
 /// Default side of the largest lighting patch, in metres.
 pub const DEFAULT_PATCH_SIZE: f32 = 0.5;
@@ -211,7 +217,12 @@ async fn read_text(reader: &mut impl SceneReader, path: &Path, referenced_at: Op
             None => SceneError::new(Location::file(path), format!("cannot read scene file: {what}")),
         }
     })?;
-    String::from_utf8(bytes).map_err(|_| SceneError::new(Location::file(path), "not UTF-8 text"))
+    let text = String::from_utf8(bytes).map_err(|_| SceneError::new(Location::file(path), "not UTF-8 text"))?;
+    // A byte-order mark (editors on Windows write one) is not part of the text.
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
+    })
 }
 
 fn build(

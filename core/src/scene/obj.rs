@@ -10,9 +10,9 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::Triangle;
 use super::error::{Location, SceneError, SceneWarning};
 use super::frame::ModelFrame;
+use super::{MAX_COORDINATE, Triangle, polygon};
 
 /// A `mtllib` or `usemtl` reference and the line it stands on.
 #[derive(Debug, Clone)]
@@ -47,7 +47,13 @@ pub fn scan(path: &Path, text: &str) -> Result<ObjScan, SceneError> {
                 }
                 for c in &coordinates[..3] {
                     match c.parse::<f64>() {
-                        Ok(v) if v.is_finite() => {}
+                        Ok(v) if v.is_finite() && v.abs() <= MAX_COORDINATE => {}
+                        Ok(v) if v.is_finite() => {
+                            return Err(SceneError::new(
+                                Location::line(path, line_no),
+                                format!("vertex coordinate {c} is beyond ±{MAX_COORDINATE:e} model units"),
+                            ));
+                        }
                         Ok(_) => {
                             return Err(SceneError::new(
                                 Location::line(path, line_no),
@@ -94,11 +100,52 @@ pub struct MtlMaterial {
 /// MTL goes through it, so `usemtl` resolves whatever the order of the lines.
 const ALL_MATERIALS: &str = "heliodon-all-materials.mtl";
 
+/// Runs a reader that may panic on input it does not expect (tobj 4 does,
+/// e.g. on `Ks 0`): `None` instead of a panic reaching the user.
+fn guarded<T>(read: impl FnOnce() -> T) -> Option<T> {
+    let quiet = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(read)).ok();
+    std::panic::set_hook(quiet);
+    result
+}
+
+/// Checks the MTL statements heliodon reads before tobj sees them: colours
+/// take three finite numbers, scalars one, `d` and `Tr` lie in 0-1. One
+/// error naming the file, line and statement.
+fn check_mtl(path: &Path, text: &str) -> Result<(), SceneError> {
+    for (k, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let Some(statement) = words.next() else { continue };
+        let count = match statement {
+            "Ka" | "Kd" | "Ks" | "Ke" | "Tf" => 3,
+            "Ns" | "Ni" | "d" | "Tr" => 1,
+            _ => continue,
+        };
+        let at = Location::line(path, k + 1);
+        let numbers = if count > 1 { "numbers" } else { "number" };
+        let values: Vec<f64> = words
+            .take(count)
+            .map(|w| w.parse::<f64>().ok().filter(|v| v.is_finite()))
+            .collect::<Option<_>>()
+            .ok_or_else(|| SceneError::new(at.clone(), format!("{statement} needs {count} finite {numbers}")))?;
+        if values.len() < count {
+            return Err(SceneError::new(at, format!("{statement} needs {count} {numbers}, not {}", values.len())));
+        }
+        if matches!(statement, "d" | "Tr") && !(0.0..=1.0).contains(&values[0]) {
+            return Err(SceneError::new(at, format!("{statement} {} is outside 0-1", values[0])));
+        }
+    }
+    Ok(())
+}
+
 /// Reads the OBJ with tobj, triangulated, with materials from `mtls`.
 pub fn import(path: &Path, text: &str, scan: &ObjScan, mtls: &[(PathBuf, String)]) -> Result<ObjModel, SceneError> {
     let mut materials: Vec<MtlMaterial> = Vec::new();
     for (mtl_path, mtl_text) in mtls {
-        let (defined, _) = tobj::load_mtl_buf(&mut Cursor::new(mtl_text.as_bytes()))
+        check_mtl(mtl_path, mtl_text)?;
+        let (defined, _) = guarded(|| tobj::load_mtl_buf(&mut Cursor::new(mtl_text.as_bytes())))
+            .ok_or_else(|| SceneError::new(Location::file(mtl_path), "cannot parse MTL: the MTL reader (tobj) failed on it"))?
             .map_err(|error| SceneError::new(Location::file(mtl_path), format!("cannot parse MTL: {error}")))?;
         for material in defined {
             let line = mtl_text
@@ -121,15 +168,18 @@ pub fn import(path: &Path, text: &str, scan: &ObjScan, mtls: &[(PathBuf, String)
     let library: Vec<tobj::Material> = materials.iter().map(|m| tobj::Material { name: m.name.clone(), ..Default::default() }).collect();
     let index: HashMap<String, usize> = materials.iter().enumerate().map(|(i, m)| (m.name.clone(), i)).collect();
     let source = format!("mtllib {ALL_MATERIALS}\n{text}");
-    let options = tobj::LoadOptions { single_index: true, triangulate: true, ignore_points: true, ignore_lines: true };
-    let (meshes, _) = tobj::load_obj_buf(&mut Cursor::new(source.as_bytes()), &options, |library_path| {
-        if library_path == Path::new(ALL_MATERIALS) {
-            Ok((library.clone(), index.clone()))
-        } else {
-            // Real libraries were read above and are already in ALL_MATERIALS.
-            Ok((Vec::new(), HashMap::new()))
-        }
+    let options = tobj::LoadOptions { single_index: true, triangulate: false, ignore_points: true, ignore_lines: true };
+    let (meshes, _) = guarded(|| {
+        tobj::load_obj_buf(&mut Cursor::new(source.as_bytes()), &options, |library_path| {
+            if library_path == Path::new(ALL_MATERIALS) {
+                Ok((library.clone(), index.clone()))
+            } else {
+                // Real libraries were read above and are already in ALL_MATERIALS.
+                Ok((Vec::new(), HashMap::new()))
+            }
+        })
     })
+    .ok_or_else(|| SceneError::new(Location::file(path), "cannot parse OBJ: the OBJ reader (tobj) failed on it"))?
     .map_err(|error| SceneError::new(Location::file(path), format!("cannot parse OBJ: {error}")))?;
     Ok(ObjModel { meshes, materials })
 }
@@ -153,12 +203,25 @@ pub fn triangles(
             frame.point(Vec3::new(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2]))
         };
         let material = material_of[&mesh.material_id];
-        for face in mesh.indices.chunks_exact(3) {
-            let triangle = Triangle { vertices: [position(face[0]), position(face[1]), position(face[2])], material };
-            if is_degenerate(&triangle) {
-                degenerate += 1;
-            } else {
-                triangles.push(triangle);
+        // Faces as written (all triangles when tobj lists no arities).
+        let arities: Box<dyn Iterator<Item = u32>> = if mesh.face_arities.is_empty() {
+            Box::new(std::iter::repeat_n(3, mesh.indices.len() / 3))
+        } else {
+            Box::new(mesh.face_arities.iter().copied())
+        };
+        let mut start = 0;
+        for arity in arities {
+            let face: Vec<Vec3> = mesh.indices[start..start + arity as usize].iter().map(|&i| position(i)).collect();
+            start += arity as usize;
+            let pieces = polygon::triangulate(&face);
+            degenerate += usize::from(pieces.is_empty());
+            for [a, b, c] in pieces {
+                let triangle = Triangle { vertices: [face[a], face[b], face[c]], material };
+                if is_degenerate(&triangle) {
+                    degenerate += 1;
+                } else {
+                    triangles.push(triangle);
+                }
             }
         }
     }

@@ -74,10 +74,10 @@ pub fn sensors(parsed: &ParsedScene) -> Result<Vec<Sensor>, SceneError> {
         let sensor = entry.get_ref();
         let key = |k: &str| format!("sensors[{i}].{k}");
         unique(&sensor.name, &key("name"))?;
-        let position = parsed.finite(&sensor.position, &key("position"))?;
+        let position = parsed.position(&sensor.position, &key("position"))?;
         let normal = parsed.finite(&sensor.normal, &key("normal"))?;
         let normal_vec = DVec3::from_array(normal);
-        if normal_vec.length() < 1e-9 {
+        if normal_vec.abs().max_element() < 1e-9 {
             return parsed.error(sensor.normal.span(), key("normal"), "the normal must not be the zero vector");
         }
         let size = match &sensor.size {
@@ -90,7 +90,9 @@ pub fn sensors(parsed: &ParsedScene) -> Result<Vec<Sensor>, SceneError> {
             }
             None => None,
         };
-        let normal = frame.direction(normal_vec.as_vec3());
+        // Normalised in f64, scaled first: a normal of enormous length must
+        // overflow neither its squared length nor f32.
+        let normal = frame.direction((normal_vec / normal_vec.abs().max_element()).normalize().as_vec3());
         out.push(Sensor {
             name: sensor.name.get_ref().clone(),
             position: frame.point(DVec3::from_array(position).as_vec3()),
@@ -106,8 +108,8 @@ pub fn sensors(parsed: &ParsedScene) -> Result<Vec<Sensor>, SceneError> {
         if grid.name.get_ref().is_empty() {
             return parsed.error(grid.name.span(), key("name"), "a grid needs a name");
         }
-        let min = parsed.finite(&grid.min, &key("min"))?;
-        let max = parsed.finite(&grid.max, &key("max"))?;
+        let min = parsed.position(&grid.min, &key("min"))?;
+        let max = parsed.position(&grid.max, &key("max"))?;
         let height = parsed.number(&grid.height, &key("height"), (f64::MIN, f64::MAX))?;
         let spacing = parsed.number(&grid.spacing, &key("spacing"), (f64::MIN_POSITIVE, f64::MAX))?;
         let cells = |axis: usize| ((max[axis] - min[axis]) / spacing + 1e-9).floor();
@@ -150,8 +152,8 @@ pub fn viewpoints(parsed: &ParsedScene) -> Result<Vec<Viewpoint>, SceneError> {
     for (i, entry) in parsed.cameras.iter().enumerate() {
         let camera = entry.get_ref();
         let key = |k: &str| format!("cameras[{i}].{k}");
-        let eye = parsed.frame.point(DVec3::from_array(parsed.finite(&camera.eye, &key("eye"))?).as_vec3());
-        let target = parsed.frame.point(DVec3::from_array(parsed.finite(&camera.target, &key("target"))?).as_vec3());
+        let eye = parsed.frame.point(DVec3::from_array(parsed.position(&camera.eye, &key("eye"))?).as_vec3());
+        let target = parsed.frame.point(DVec3::from_array(parsed.position(&camera.target, &key("target"))?).as_vec3());
         if (target - eye).length() < 1e-6 {
             return parsed.error(camera.target.span(), key("target"), "the target must differ from the eye");
         }

@@ -8,6 +8,7 @@ use crate::cli::CliError;
 use crate::cli::args::{Format, SkyArgs, load_for_command, precompute_progress, sky_for};
 use crate::light::{LightSettings, Lighting, cache};
 use crate::panel::PanelCatalog;
+use crate::report::{csv_field, json_string};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
 
 #[derive(clap::Args, Debug)]
@@ -82,7 +83,15 @@ pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, Stri
             Format::Csv => {
                 for r in &lighting.sensors {
                     let prefix = if several { format!("{},{},", when.date, when.time) } else { String::new() };
-                    let _ = writeln!(out, "{prefix}{},{:.1},{:.1},{:.1},{:.1}", r.name, r.total, r.direct_sun, r.direct_sky, r.indirect);
+                    let _ = writeln!(
+                        out,
+                        "{prefix}{},{:.1},{:.1},{:.1},{:.1}",
+                        csv_field(&r.name),
+                        r.total,
+                        r.direct_sun,
+                        r.direct_sky,
+                        r.indirect
+                    );
                 }
             }
             Format::Json => {
@@ -91,14 +100,14 @@ pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, Stri
                     .iter()
                     .map(|r| {
                         format!(
-                            "{{\"name\": {:?}, \"illuminance_lux\": {:.1}, \"direct_sun_lux\": {:.1}, \"direct_sky_lux\": {:.1}, \"indirect_lux\": {:.1}}}",
-                            r.name, r.total, r.direct_sun, r.direct_sky, r.indirect
+                            "{{\"name\": {}, \"illuminance_lux\": {:.1}, \"direct_sun_lux\": {:.1}, \"direct_sky_lux\": {:.1}, \"indirect_lux\": {:.1}}}",
+                            json_string(&r.name), r.total, r.direct_sun, r.direct_sky, r.indirect
                         )
                     })
                     .collect();
                 json.push(format!(
-                    "{{\"date\": \"{}\", \"time\": \"{}\", \"sun_altitude_deg\": {:.4}, \"sun_azimuth_deg\": {:.4}, \"sky\": \"{}\", \"sensors\": [{}]}}",
-                    when.date, when.time, position.altitude, position.azimuth, args.sky.sky, rows.join(", ")
+                    "{{\"date\": \"{}\", \"time\": \"{}\", \"sun_altitude_deg\": {:.4}, \"sun_azimuth_deg\": {:.4}, \"sky\": {}, \"sensors\": [{}]}}",
+                    when.date, when.time, position.altitude, position.azimuth, json_string(&args.sky.sky), rows.join(", ")
                 ));
             }
             Format::Table => {

@@ -9,6 +9,7 @@ use egui_plot::{Heatmap, Legend, Line, Plot, PlotPoint, PlotPoints, Points, VLin
 
 use crate::day::{DAY_STEPS, YEAR_DAYS};
 use crate::ecs::{ActiveScene, LightingState};
+use crate::report::csv_field;
 use crate::time::LocalDateTime;
 use crate::viewer::sensors::{DaySeries, SelectedSensor, YearMap};
 
@@ -61,7 +62,7 @@ fn sensor_panel(ui: &mut Ui, note: &mut Option<String>, sensors: &mut SensorPane
         if ui.button("Export table (CSV)").clicked() {
             let mut csv = String::from("name,illuminance_lux,direct_sun_lux,direct_sky_lux,indirect_lux\n");
             for r in readings {
-                csv.push_str(&format!("{},{:.1},{:.1},{:.1},{:.1}\n", r.name, r.total, r.direct_sun, r.direct_sky, r.indirect));
+                csv.push_str(&format!("{},{:.1},{:.1},{:.1},{:.1}\n", csv_field(&r.name), r.total, r.direct_sun, r.direct_sky, r.indirect));
             }
             *note = Some(write_export("heliodon-sensors.csv", &csv));
         }
