@@ -313,10 +313,21 @@ fn the_cache_is_used_and_never_trusted_when_damaged() {
         assert_eq!(outcome, CacheOutcome::Rebuilt(path.clone(), why.to_string()));
         assert_eq!(model.solve(&sky, None), expected);
     }
-    // A different model is a different key; different settings too.
+    // A comment or a new sensor name is the same key; a different model is a
+    // different key; different settings too.
     let obj = std::fs::read_to_string(work.join("model.obj")).unwrap();
     std::fs::write(work.join("model.obj"), format!("{obj}# edited\n")).unwrap();
-    let (_, outcome) = precompute_cached(scene.clone(), settings, Some(&dir), &|_| {}).unwrap();
+    let text = std::fs::read_to_string(work.join("scene.toml")).unwrap();
+    std::fs::write(work.join("scene.toml"), format!("# a comment\n{}", text.replacen("name = \"s00\"", "name = \"first\"", 1))).unwrap();
+    let renamed = load(&work.join("scene.toml"));
+    assert_eq!(renamed.sensors[0].name, "first");
+    let (_, outcome) = precompute_cached(renamed, settings, Some(&dir), &|_| {}).unwrap();
+    assert_eq!(outcome, CacheOutcome::Hit(path.clone()));
+    let first_vertex = obj.lines().find(|l| l.starts_with("v ")).unwrap();
+    let corner: Vec<f64> = first_vertex[2..].split_whitespace().map(|c| c.parse::<f64>().unwrap()).collect();
+    let moved = obj.replacen(first_vertex, &format!("v {} {} {}", corner[0] + 0.01, corner[1], corner[2]), 1);
+    std::fs::write(work.join("model.obj"), moved).unwrap();
+    let (_, outcome) = precompute_cached(load(&work.join("scene.toml")), settings, Some(&dir), &|_| {}).unwrap();
     assert!(matches!(&outcome, CacheOutcome::Stored(p) if *p != path), "{outcome:?}");
     let (_, outcome) = precompute_cached(scene.clone(), LightSettings { rays_per_patch: 65, ..settings }, Some(&dir), &|_| {}).unwrap();
     assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");

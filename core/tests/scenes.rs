@@ -257,6 +257,35 @@ fn malformed_mtl_statements_are_one_line() {
     assert_eq!(loaded.scene.windows.len(), 1);
 }
 
+/// `patch_size` stays where the engine is right: outside 0.05-10 m an
+/// error naming the key, above 1 m a warning, and a size that would need
+/// more than a million patches is refused before any is cut.
+#[test]
+fn patch_sizes_are_bounded_by_what_the_engine_handles() {
+    let with = |size: &str| scene_toml(&format!("\n[lighting]\npatch_size = {size}\n"));
+    for size in ["0.01", "1000.0"] {
+        let e = fixture(&format!("patch_{size}"), &with(size), OBJ).error();
+        assert_eq!(e.location.key.as_deref(), Some("lighting.patch_size"), "{e}");
+    }
+    let coarse = fixture("patch_coarse", &with("2.0"), OBJ).load().unwrap();
+    assert!(coarse.warnings.iter().any(|w| w.message.contains("loses accuracy")), "{:?}", coarse.warnings);
+    // A 2 km square slab at 5 cm: 1.6 billion patches, refused at once.
+    let slab = "mtllib room.mtl\nv 0 0 0\nv 2000 0 0\nv 2000 2000 0\nv 0 2000 0\nusemtl wall\nf 1 2 3 4\n";
+    let e = fixture("patch_too_many", &with("0.05"), slab).error();
+    assert!(e.message.contains("more than 1000000 patches"), "{e}");
+}
+
+/// Copies of one face load in near-linear time and count once, with a
+/// warning.
+#[test]
+fn duplicated_faces_count_once() {
+    let copies = "f 1 2 3\n".repeat(50_000);
+    let obj = OBJ.replace("usemtl wall\nf 1 2 3\n", &format!("usemtl wall\n{copies}"));
+    let loaded = fixture("duplicates", &scene_toml(""), &obj).load().unwrap();
+    assert_eq!(loaded.scene.triangles.len(), 2);
+    assert!(loaded.warnings.iter().any(|w| w.message.contains("dropped 49999 duplicated triangle(s)")), "{:?}", loaded.warnings);
+}
+
 #[test]
 fn unused_scene_material_is_a_warning() {
     let f = fixture("unused", &scene_toml("\n[materials.marble]\nkind = \"diffuse\"\nreflectance = 0.7\n"), OBJ);

@@ -1,7 +1,8 @@
 //! The precomputation on disk. A model's gathers (sky coefficients, form
-//! factors, sensor rays) are stored under a key hashed from the scene file,
-//! the OBJ, the MTLs, the light settings and this format's version; the BVH
-//! is rebuilt on load. A file whose header, length or checksum does not
+//! factors, sensor rays) are stored under a key hashed from what they
+//! depend on ([`key`]: the loaded geometry and patches, the materials' light
+//! passing, the sensors' placement, the settings and this format's version;
+//! not comments or names); the BVH is rebuilt on load. A file whose header, length or checksum does not
 //! match is rebuilt, never trusted. Files are written whole and renamed into
 //! place (a reader never sees half a file), and the folder is kept under a
 //! size bound ([`size_limit`]), least recently used files first to go;
@@ -68,14 +69,28 @@ impl Fnv {
     }
 }
 
-/// The key of a scene's precomputation: its files' bytes and the settings
-/// that shape the result (not the thread count).
-pub fn key(scene: &Scene, settings: &LightSettings) -> std::io::Result<u64> {
+/// The key of a scene's precomputation: what the gathers depend on, and
+/// nothing else. The patches' geometry (the model after loading, its frame
+/// and patch sizes), which materials pass light and how, which surface has
+/// which, the sensors' placement, and the settings that shape the result;
+/// not comments, names, reflectances, the site or the thread count.
+pub fn key(scene: &Scene, settings: &LightSettings) -> u64 {
     let mut hash = Fnv::new();
     hash.bytes(MAGIC).u64(u64::from(FORMAT)).bytes(env!("CARGO_PKG_VERSION").as_bytes());
-    for path in std::iter::once(&scene.files.scene).chain(std::iter::once(&scene.files.obj)).chain(&scene.files.mtls) {
-        let data = fs::read(path)?;
-        hash.u64(data.len() as u64).bytes(&data);
+    let mut floats = |values: &[f32]| {
+        for v in values {
+            hash.bytes(&v.to_bits().to_le_bytes());
+        }
+    };
+    for triangle in &scene.patches.triangles {
+        floats(&triangle.map(|v| v.to_array()).concat());
+    }
+    for sensor in &scene.sensors {
+        floats(&[sensor.position.to_array(), sensor.normal.to_array(), sensor.axes[0].to_array(), sensor.axes[1].to_array()].concat());
+        floats(&[sensor.size.unwrap_or(-1.0)]);
+    }
+    for patch in &scene.patches.patches {
+        hash.u64(u64::from(patch.triangles.end)).u64(u64::from(patch.surface)).u64(u64::from(patch.material));
     }
     // Materials edited at run time: what the gathers depend on (which
     // materials pass light, and glass transmittance; not reflectances), and
@@ -98,7 +113,7 @@ pub fn key(scene: &Scene, settings: &LightSettings) -> std::io::Result<u64> {
         .u64(u64::from(settings.sky_subdivision))
         .u64(settings.max_iterations as u64)
         .u64(settings.tolerance.to_bits());
-    Ok(hash.0)
+    hash.0
 }
 
 /// Precomputes `scene`, going through the cache in `dir` (none: no cache).
@@ -112,13 +127,7 @@ pub fn precompute_cached(
     let Some(dir) = dir else {
         return Ok((LightModel::precompute_with_progress(scene, settings, progress)?, CacheOutcome::Skipped("disabled".into())));
     };
-    let key = match key(&scene, &settings) {
-        Ok(key) => key,
-        Err(e) => {
-            let model = LightModel::precompute_with_progress(scene, settings, progress)?;
-            return Ok((model, CacheOutcome::Skipped(format!("cannot read the scene's files to key the cache: {e}"))));
-        }
-    };
+    let key = key(&scene, &settings);
     let path = dir.join(format!("light-{key:016x}.bin"));
     let mut rebuilt = None;
     if let Ok(bytes) = fs::read(&path) {

@@ -10,7 +10,7 @@ use toml::Spanned;
 
 use super::error::{Location, SceneError};
 use super::frame::{ModelFrame, UpAxis};
-use super::{DEFAULT_PATCH_SIZE, MAX_COORDINATE};
+use super::{DEFAULT_PATCH_SIZE, MAX_COORDINATE, MAX_PATCH_SIZE, MIN_PATCH_SIZE};
 use crate::site::Site;
 
 #[derive(Debug, Deserialize)]
@@ -187,7 +187,7 @@ pub fn parse(path: &Path, text: &str) -> Result<ParsedScene, SceneError> {
     parsed.frame = frame(&parsed)?;
     if let Some(lighting) = file.lighting {
         if let Some(size) = lighting.patch_size {
-            parsed.patch_size = parsed.number(&size, "lighting.patch_size", (0.01, 1000.0))? as f32;
+            parsed.patch_size = parsed.number(&size, "lighting.patch_size", (MIN_PATCH_SIZE, MAX_PATCH_SIZE))? as f32;
         }
         parsed.adaptive_patches = lighting.adaptive.unwrap_or(true);
     }

@@ -196,6 +196,10 @@ pub fn triangles(
 ) -> Result<Vec<Triangle>, SceneError> {
     let mut triangles = Vec::new();
     let mut degenerate = 0usize;
+    // Faces written twice (same corners, same material) count once: copies
+    // would weigh on every ray and pass for nothing.
+    let mut seen: std::collections::HashSet<([[u32; 3]; 3], u32)> = std::collections::HashSet::new();
+    let mut duplicated = 0usize;
     for model_mesh in &model.meshes {
         let mesh = &model_mesh.mesh;
         let position = |i: u32| {
@@ -217,13 +221,23 @@ pub fn triangles(
             degenerate += usize::from(pieces.is_empty());
             for [a, b, c] in pieces {
                 let triangle = Triangle { vertices: [face[a], face[b], face[c]], material };
+                let mut corners = triangle.vertices.map(|v| v.to_array().map(f32::to_bits));
+                corners.sort_unstable();
                 if is_degenerate(&triangle) {
                     degenerate += 1;
+                } else if !seen.insert((corners, material)) {
+                    duplicated += 1;
                 } else {
                     triangles.push(triangle);
                 }
             }
         }
+    }
+    if duplicated > 0 {
+        warnings.push(SceneWarning {
+            location: Location::file(path),
+            message: format!("dropped {duplicated} duplicated triangle(s) (the same corners and material twice)"),
+        });
     }
     if degenerate > 0 {
         warnings.push(SceneWarning {

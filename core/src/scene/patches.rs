@@ -155,7 +155,52 @@ struct Quadtree<'a> {
     root: Cell,
 }
 
-impl Quadtree<'_> {
+impl<'a> Quadtree<'a> {
+    /// The quadtree of `surface` (made of `tris`), rooted at its corner.
+    fn for_surface(sizing: &'a PatchSizing, surface: &Surface, tris: &[Triangle]) -> Self {
+        let (u, v) = plane_axes(surface.normal);
+        let origin =
+            tris.iter().flat_map(|t| t.vertices).fold((f32::INFINITY, f32::INFINITY), |(a, b), p| (a.min(p.dot(u)), b.min(p.dot(v))));
+        let extent = tris
+            .iter()
+            .flat_map(|t| t.vertices)
+            .map(|p| (((p.dot(u) - origin.0) / sizing.finest).floor() as i64).max(((p.dot(v) - origin.1) / sizing.finest).floor() as i64))
+            .fold(0, i64::max)
+            + 1;
+        let level = (extent.max(1) as u64).next_power_of_two().trailing_zeros();
+        Quadtree {
+            sizing,
+            u,
+            v,
+            offset: surface.normal.dot(tris[0].vertices[0]),
+            normal: surface.normal,
+            origin,
+            root: Cell { i: 0, j: 0, level },
+        }
+    }
+
+    /// The finest cell (i, j) holding `p`.
+    fn cell_of(&self, p: Vec3) -> (i64, i64) {
+        (
+            ((p.dot(self.u) - self.origin.0) / self.sizing.finest).floor() as i64,
+            ((p.dot(self.v) - self.origin.1) / self.sizing.finest).floor() as i64,
+        )
+    }
+
+    /// Adds the leaves under `cell` to `count`, stopping at `limit`.
+    fn count_leaves(&self, cell: Cell, count: &mut u64, limit: u64) {
+        if *count >= limit {
+            return;
+        }
+        if self.is_leaf(cell) {
+            *count += 1;
+            return;
+        }
+        for child in self.children(cell) {
+            self.count_leaves(child, count, limit);
+        }
+    }
+
     fn span(&self, cell: Cell) -> i64 {
         1 << cell.level
     }
@@ -208,6 +253,23 @@ impl Quadtree<'_> {
     }
 }
 
+/// About how many patches `subdivide` would cut, counted before cutting
+/// them (every quadtree leaf over each surface's bounds: an upper bound),
+/// and no further than `limit`: work that would not fit is refused before
+/// it is done.
+pub fn estimate(triangles: &[Triangle], surfaces: &[Surface], sizing: &PatchSizing, limit: u64) -> u64 {
+    let mut count = 0;
+    for surface in surfaces {
+        let tris = &triangles[surface.triangles.start as usize..surface.triangles.end as usize];
+        let tree = Quadtree::for_surface(sizing, surface, tris);
+        tree.count_leaves(tree.root, &mut count, limit);
+        if count >= limit {
+            break;
+        }
+    }
+    count
+}
+
 /// Surfaces smaller than this share of the allowed patch's area are clutter.
 const CLUTTER: f32 = 0.25;
 
@@ -246,7 +308,6 @@ fn clusters(triangles: &[Triangle], surfaces: &[Surface], sizing: &PatchSizing, 
 /// the clutter among the surfaces `clusterable` allows into clusters, and
 /// sets each surface's patch range.
 pub fn subdivide(triangles: &[Triangle], surfaces: &mut [Surface], sizing: &PatchSizing, clusterable: &[bool]) -> PatchMesh {
-    let size = sizing.finest;
     let mut mesh = PatchMesh::default();
     let (cluster_of, members) = clusters(triangles, surfaces, sizing, clusterable);
     for index in 0..surfaces.len() {
@@ -262,21 +323,9 @@ pub fn subdivide(triangles: &[Triangle], surfaces: &mut [Surface], sizing: &Patc
         }
         let surface = &mut surfaces[index];
         let tris = &triangles[surface.triangles.start as usize..surface.triangles.end as usize];
-        let (u, v) = plane_axes(surface.normal);
-        let origin =
-            tris.iter().flat_map(|t| t.vertices).fold((f32::INFINITY, f32::INFINITY), |(a, b), p| (a.min(p.dot(u)), b.min(p.dot(v))));
-        let cell_of = |p: Vec3| (((p.dot(u) - origin.0) / size).floor() as i64, ((p.dot(v) - origin.1) / size).floor() as i64);
-        let extent = tris.iter().flat_map(|t| t.vertices).map(cell_of).fold(0, |m, (i, j)| m.max(i).max(j)) + 1;
-        let level = (extent.max(1) as u64).next_power_of_two().trailing_zeros();
-        let tree = Quadtree {
-            sizing,
-            u,
-            v,
-            offset: surface.normal.dot(tris[0].vertices[0]),
-            normal: surface.normal,
-            origin,
-            root: Cell { i: 0, j: 0, level },
-        };
+        let tree = Quadtree::for_surface(sizing, surface, tris);
+        let (u, v) = (tree.u, tree.v);
+        let cell_of = |p: Vec3| tree.cell_of(p);
         let mut cells: BTreeMap<(i64, i64), Vec<[Vec3; 3]>> = BTreeMap::new();
         let mut leaves = Vec::new();
         for triangle in tris {

@@ -29,14 +29,25 @@ pub fn group(triangles: Vec<Triangle>) -> (Vec<Triangle>, Vec<Surface>) {
             edges.entry(edge).or_default().push(t as u32);
         }
     }
-    // HashMap order does not matter: unions give the same partition in any order.
+    // HashMap order does not matter: unions give the same partition in any
+    // order. Each triangle on an edge joins every earlier *representative*
+    // it fits (same material, coplanar), or becomes one: near-linear even
+    // when thousands of copies of a face share its edges.
+    let mut representatives: Vec<u32> = Vec::new();
     for sharing in edges.values() {
-        for (i, &a) in sharing.iter().enumerate() {
-            for &b in &sharing[i + 1..] {
-                let (ta, tb) = (&triangles[a as usize], &triangles[b as usize]);
-                if ta.material == tb.material && normals[a as usize].dot(normals[b as usize]) >= COPLANAR_COS {
-                    sets.union(a, b);
-                }
+        representatives.clear();
+        for &t in sharing {
+            let fits = |r: &u32| {
+                triangles[*r as usize].material == triangles[t as usize].material
+                    && normals[*r as usize].dot(normals[t as usize]) >= COPLANAR_COS
+            };
+            let mut joined = false;
+            for &r in representatives.iter().filter(|r| fits(r)) {
+                sets.union(r, t);
+                joined = true;
+            }
+            if !joined {
+                representatives.push(t);
             }
         }
     }
