@@ -451,3 +451,57 @@ fn a_glass_box_is_read_as_one_pane() {
     let (one, box_pane) = (sky(&thin.scene), sky(&thick.scene));
     assert!((box_pane - one).abs() < 0.02 * one, "a box pane passes {box_pane} lx of sky, one face {one} lx");
 }
+
+/// A sensor grid far larger than memory allows is refused before any ray is
+/// traced, with one line saying what it would need.
+#[test]
+fn work_that_would_not_fit_in_memory_is_refused_first() {
+    let path = on_a_ground("big_grid", 20.0, 20.0, true);
+    let text = std::fs::read_to_string(&path).unwrap().replace("spacing = 1.0", "spacing = 0.005");
+    std::fs::write(&path, text).unwrap();
+    let scene = load(&path);
+    assert!(scene.sensors.len() > 400_000, "{}", scene.sensors.len());
+    let error = LightModel::precompute(scene, LightSettings::default()).err().expect("refused");
+    assert!(error.contains("could need") && error.contains("GiB") && error.contains("wider grid spacing"), "{error}");
+    assert!(!error.contains('\n'));
+}
+
+/// A model in survey coordinates (4,100 km north, 512 km east, as UTM
+/// writes it) is recentred in f64 before f32 and reads as the same model
+/// near the origin does, with one warning.
+#[test]
+fn survey_coordinates_are_recentred_for_precision() {
+    let near = on_a_ground("survey_near", 10.0, 10.0, true);
+    let far = on_a_ground("survey_far", 10.0, 10.0, true);
+    let (dx, dy) = (512_345.678, 4_100_123.456);
+    let obj: String = std::fs::read_to_string(far.with_file_name("room.obj"))
+        .unwrap()
+        .lines()
+        .map(|l| match l.strip_prefix("v ") {
+            Some(v) => {
+                let c: Vec<f64> = v.split_whitespace().map(|c| c.parse().unwrap()).collect();
+                format!("v {:.6} {:.6} {:.6}\n", c[0] + dx, c[1] + dy, c[2])
+            }
+            None => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(far.with_file_name("room.obj"), obj).unwrap();
+    let text = std::fs::read_to_string(&far).unwrap();
+    let text = text
+        .replace("min = [0.5, 0.5]", &format!("min = [{}, {}]", 0.5 + dx, 0.5 + dy))
+        .replace("max = [3.5, 5.5]", &format!("max = [{}, {}]", 3.5 + dx, 5.5 + dy));
+    std::fs::write(&far, text).unwrap();
+    let far = load_scene(&far, &PanelCatalog::new()).unwrap();
+    assert!(far.warnings.iter().any(|w| w.message.contains("recentred")), "{:?}", far.warnings);
+    let near = load(&near);
+    let far = Arc::new(far.scene);
+    assert_eq!(far.patches.patches.len(), near.patches.patches.len());
+    assert!((far.windows[0].area - near.windows[0].area).abs() < 1e-4, "{} vs {}", far.windows[0].area, near.windows[0].area);
+    let light = |scene: &Arc<Scene>| {
+        let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
+        model.solve(&sky_at(scene, &SkySpec::Overcast, "2026-03-21", "12:00"), None).sensors.iter().map(|r| r.total).collect::<Vec<f64>>()
+    };
+    for (f, n) in light(&far).iter().zip(light(&near)) {
+        assert!((f - n).abs() < 0.01 * n, "{f} vs {n}");
+    }
+}

@@ -17,6 +17,31 @@ use super::sampling::{Rng, cosine_directions, point_on_triangle};
 use super::{LightModel, LightSettings, MAX_GLASS_DEPTH, MIN_WEIGHT, SURFACE_OFFSET, Surface, par_map};
 use crate::scene::{Scene, Sensor};
 
+/// The memory the gathers may take, MiB: `$HELIODON_MEMORY_MB`, else 8 GiB.
+pub fn memory_budget_mib() -> u64 {
+    std::env::var("HELIODON_MEMORY_MB").ok().and_then(|v| v.trim().parse::<u64>().ok()).unwrap_or(8192)
+}
+
+/// Refuses, before any ray is traced, a precomputation whose gathers could
+/// outgrow the memory budget: at most 8 bytes per patch-side ray and 28 per
+/// sensor ray (a share, and where the ray landed).
+fn check_memory(scene: &Scene, settings: &LightSettings) -> Result<(), String> {
+    let sides = 2.0 * scene.patches.patches.len() as f64 * settings.rays_per_patch as f64 * 8.0;
+    let sensors = scene.sensors.len() as f64 * settings.rays_per_sensor as f64 * 28.0;
+    let (need, budget) = ((sides + sensors) / 1048576.0, memory_budget_mib() as f64);
+    if need > budget {
+        return Err(format!(
+            "{}: {} sensors and {} patches could need {:.1} GiB of light data, more than the {:.1} GiB allowed (HELIODON_MEMORY_MB): use fewer sensors (a wider grid spacing) or a larger patch_size",
+            scene.files.scene.display(),
+            scene.sensors.len(),
+            scene.patches.patches.len(),
+            need / 1024.0,
+            budget / 1024.0
+        ));
+    }
+    Ok(())
+}
+
 /// Sensors closer than this to a surface behind them read as lifted this far.
 const SENSOR_LIFT: f64 = 0.01;
 
@@ -108,6 +133,7 @@ impl LightModel {
     /// [`Self::precompute`], reporting the fraction done (0-1) now and then.
     pub fn precompute_with_progress(scene: Arc<Scene>, settings: LightSettings, progress: &(dyn Fn(f64) + Sync)) -> Result<Self, String> {
         settings.check()?;
+        check_memory(&scene, &settings)?;
         let mut model = Self::empty(scene, settings);
         let patches = &model.scene.patches.patches;
         let total = patches.len() * 2 + model.scene.sensors.len();

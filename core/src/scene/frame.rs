@@ -2,7 +2,7 @@
 //! unit measures, mapped into heliodon's canonical frame (metres, x east,
 //! y north, z up, as in Radiance).
 
-use glam::{Mat3, Vec3};
+use glam::{DVec3, Mat3, Vec3};
 
 /// The model's vertical axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -58,6 +58,10 @@ pub struct ModelFrame {
     pub north: Vec3,
     /// Metres per model unit.
     pub scale: f32,
+    /// The model-space point placed at the canonical origin: zero, or the
+    /// centre of a model given in survey coordinates (recentred in f64
+    /// before anything becomes f32, which keeps millimetres only near 0).
+    pub origin: DVec3,
     rotation: Mat3,
 }
 
@@ -81,7 +85,7 @@ impl ModelFrame {
         }
         let angle = horizontal.x.atan2(horizontal.y);
         let rotation = Mat3::from_rotation_z(angle) * up.to_z_up();
-        Ok(Self { up, north, scale, rotation })
+        Ok(Self { up, north, scale, origin: DVec3::ZERO, rotation })
     }
 
     /// Where the scene file puts true north: degrees clockwise (seen from
@@ -91,9 +95,9 @@ impl ModelFrame {
         f64::from(level.x.atan2(level.y).to_degrees())
     }
 
-    /// A model-space point in canonical coordinates.
-    pub fn point(&self, p: Vec3) -> Vec3 {
-        self.rotation * (p * self.scale)
+    /// A model-space point in canonical coordinates (relative to [`Self::origin`]).
+    pub fn point(&self, p: DVec3) -> Vec3 {
+        self.rotation * ((p - self.origin).as_vec3() * self.scale)
     }
 
     /// A model-space direction in canonical coordinates (unit length).
@@ -123,7 +127,7 @@ mod tests {
     #[test]
     fn z_up_with_default_north_is_the_identity() {
         let frame = ModelFrame::new(UpAxis::Z, None, 1.0).unwrap();
-        assert!(close(frame.point(Vec3::new(1.0, 2.0, 3.0)), Vec3::new(1.0, 2.0, 3.0)));
+        assert!(close(frame.point(DVec3::new(1.0, 2.0, 3.0)), Vec3::new(1.0, 2.0, 3.0)));
     }
 
     #[test]
@@ -141,7 +145,7 @@ mod tests {
         let frame = ModelFrame::new(UpAxis::Z, Some(Vec3::X), 2.0).unwrap();
         assert!(close(frame.direction(Vec3::X), Vec3::Y));
         assert!(close(frame.direction(Vec3::Y), Vec3::NEG_X));
-        assert!(close(frame.point(Vec3::new(1.0, 0.0, 1.0)), Vec3::new(0.0, 2.0, 2.0)));
+        assert!(close(frame.point(DVec3::new(1.0, 0.0, 1.0)), Vec3::new(0.0, 2.0, 2.0)));
         let m = Mat3::from_cols(frame.direction(Vec3::X), frame.direction(Vec3::Y), frame.direction(Vec3::Z));
         assert!((m.determinant() - 1.0).abs() < 1e-6);
     }

@@ -284,7 +284,8 @@ fn mtl_material(source: &super::obj::MtlMaterial) -> Result<Material, SceneError
         .get("Tr")
         .map(|tr| tr.trim().parse::<f32>().map_err(|_| error(format!("material '{}': Tr '{tr}' is not a number", source.name))))
         .transpose()?;
-    let transmittance = match (definition.dissolve, transparency) {
+    // tobj reads in f64 (for the positions); materials are f32 as ever.
+    let transmittance = match (definition.dissolve.map(|d| d as f32), transparency) {
         (_, Some(tr)) if tr > 0.0 => Some(tr),
         (Some(d), _) if d < 1.0 => Some(1.0 - d),
         _ => None,
@@ -293,7 +294,7 @@ fn mtl_material(source: &super::obj::MtlMaterial) -> Result<Material, SceneError
         Some(t) if (0.0..=1.0).contains(&t) => MaterialKind::Glass { transmittance: t },
         Some(t) => return Err(error(format!("material '{}': transmittance {t} is out of range [0, 1]", source.name))),
         None => {
-            let kd = definition.diffuse.unwrap_or([UNASSIGNED_REFLECTANCE; 3]);
+            let kd = definition.diffuse.map_or([UNASSIGNED_REFLECTANCE; 3], |kd| kd.map(|c| c as f32));
             if kd.iter().any(|c| !(0.0..=1.0).contains(c)) {
                 return Err(error(format!("material '{}': Kd {kd:?} must lie in [0, 1]", source.name)));
             }

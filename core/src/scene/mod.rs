@@ -50,6 +50,10 @@ pub const ACCURATE_PATCH_SIZE: f32 = 1.0;
 /// 3 kB each once gathered: a million is 3 GB).
 pub const MAX_PATCHES: f64 = 1.0e6;
 
+/// Models whose centre lies farther than this from their origin (model
+/// units) are recentred: f32 keeps about a millimetre at 10 km.
+pub const RECENTRE_BEYOND: f64 = 1e4;
+
 /// Default side of the largest lighting patch, in metres.
 pub const DEFAULT_PATCH_SIZE: f32 = 0.5;
 
@@ -237,7 +241,7 @@ async fn read_text(reader: &mut impl SceneReader, path: &Path, referenced_at: Op
 }
 
 fn build(
-    parsed: file::ParsedScene,
+    mut parsed: file::ParsedScene,
     obj_path: PathBuf,
     obj_text: &str,
     obj_scan: obj::ObjScan,
@@ -247,6 +251,21 @@ fn build(
     let mut warnings = Vec::new();
     let model = obj::import(&obj_path, obj_text, &obj_scan, &mtls)?;
     let (materials, material_of) = material::resolve(&parsed, &model, panels, &obj_path, &mut warnings)?;
+    // A model in survey coordinates is recentred, in f64, before anything
+    // becomes f32 (which keeps millimetres only within a few km of 0).
+    if let Some(centre) = obj::far_centre(&model, RECENTRE_BEYOND) {
+        parsed.frame.origin = centre;
+        warnings.push(SceneWarning {
+            location: Location::file(&obj_path),
+            message: format!(
+                "the model lies {:.0} km from its origin (survey coordinates?): it is recentred on ({:.3}, {:.3}, {:.3}) for precision; positions heliodon prints are relative to that point",
+                centre.length() * f64::from(parsed.frame.scale) / 1000.0,
+                centre.x,
+                centre.y,
+                centre.z
+            ),
+        });
+    }
     let raw_triangles = obj::triangles(&model, &parsed.frame, &material_of, &obj_path, &mut warnings)?;
     let (mut triangles, mut surfaces) = surfaces::group(raw_triangles);
     let (box_faces, panes) = repair::thick_glass(&triangles, &surfaces, &materials);

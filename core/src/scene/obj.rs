@@ -8,7 +8,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use super::error::{Location, SceneError, SceneWarning};
 use super::frame::ModelFrame;
@@ -204,7 +204,7 @@ pub fn triangles(
         let mesh = &model_mesh.mesh;
         let position = |i: u32| {
             let i = i as usize * 3;
-            frame.point(Vec3::new(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2]))
+            frame.point(DVec3::new(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2]))
         };
         let material = material_of[&mesh.material_id];
         // Faces as written (all triangles when tobj lists no arities).
@@ -249,6 +249,19 @@ pub fn triangles(
         return Err(SceneError::new(Location::file(path), "the model has no faces with a non-zero area"));
     }
     Ok(triangles)
+}
+
+/// The centre of the model's bounds (model units, f64) when it lies farther
+/// than `beyond` from the origin; `None` for a model near its origin.
+pub fn far_centre(model: &ObjModel, beyond: f64) -> Option<DVec3> {
+    let (lo, hi) = model
+        .meshes
+        .iter()
+        .flat_map(|m| m.mesh.positions.chunks_exact(3))
+        .map(|p| DVec3::new(p[0], p[1], p[2]))
+        .fold((DVec3::MAX, DVec3::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    let centre = (lo + hi) / 2.0;
+    (lo.x <= hi.x && centre.abs().max_element() > beyond).then_some(centre)
 }
 
 /// Zero area, up to rounding: the smallest angle's sine below 1e-6 or an area

@@ -95,7 +95,7 @@ pub fn sensors(parsed: &ParsedScene) -> Result<Vec<Sensor>, SceneError> {
         let normal = frame.direction((normal_vec / normal_vec.abs().max_element()).normalize().as_vec3());
         out.push(Sensor {
             name: sensor.name.get_ref().clone(),
-            position: frame.point(DVec3::from_array(position).as_vec3()),
+            position: frame.point(DVec3::from_array(position)),
             normal,
             size,
             axes: axes_for(normal),
@@ -130,7 +130,7 @@ pub fn sensors(parsed: &ParsedScene) -> Result<Vec<Sensor>, SceneError> {
             for i in 0..nx as usize {
                 let x = min[0] + (i as f64 + 0.5) * spacing;
                 let y = min[1] + (j as f64 + 0.5) * spacing;
-                let model_point = ax * x as f32 + ay * y as f32 + model_up * height as f32;
+                let model_point = ax.as_dvec3() * x + ay.as_dvec3() * y + model_up.as_dvec3() * height;
                 let name = format!("{}/{}", grid.name.get_ref(), j * nx as usize + i);
                 unique(&Spanned::new(grid.name.span(), name.clone()), &key("name"))?;
                 out.push(Sensor {
@@ -152,8 +152,8 @@ pub fn viewpoints(parsed: &ParsedScene) -> Result<Vec<Viewpoint>, SceneError> {
     for (i, entry) in parsed.cameras.iter().enumerate() {
         let camera = entry.get_ref();
         let key = |k: &str| format!("cameras[{i}].{k}");
-        let eye = parsed.frame.point(DVec3::from_array(parsed.position(&camera.eye, &key("eye"))?).as_vec3());
-        let target = parsed.frame.point(DVec3::from_array(parsed.position(&camera.target, &key("target"))?).as_vec3());
+        let eye = parsed.frame.point(DVec3::from_array(parsed.position(&camera.eye, &key("eye"))?));
+        let target = parsed.frame.point(DVec3::from_array(parsed.position(&camera.target, &key("target"))?));
         if (target - eye).length() < 1e-6 {
             return parsed.error(camera.target.span(), key("target"), "the target must differ from the eye");
         }
