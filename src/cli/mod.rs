@@ -137,3 +137,63 @@ pub fn main(panels: PanelCatalog) -> ExitCode {
         ExitCode::from(error.code)
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fixed-seed fuzzer over the flags: any sequence of words parses or
+    /// gives clap's error, never a panic.
+    #[test]
+    fn random_flags_never_panic() {
+        let words = [
+            "sensors",
+            "sun",
+            "render",
+            "info",
+            "view",
+            "export-radiance",
+            "--date",
+            "--time",
+            "--sky",
+            "--dni",
+            "--dhi",
+            "--format",
+            "--eye",
+            "--target",
+            "--fov",
+            "--width",
+            "--latitude",
+            "--longitude",
+            "--timezone",
+            "--day",
+            "2026-02-30",
+            "24:00",
+            "99999999:00",
+            "-5",
+            "nan",
+            "1e39",
+            "csv",
+            "clear",
+            "perez",
+            "cie:16",
+            "1,2",
+            "1,2,3",
+            "scene.toml",
+            "",
+            "--",
+            "-",
+        ];
+        let mut state: u64 = 7;
+        for _ in 0..2000 {
+            let mut args = vec!["heliodon".to_string()];
+            for _ in 0..(state % 9) {
+                state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                args.push(words[((state >> 33) as usize) % words.len()].to_string());
+            }
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let parsed = std::panic::catch_unwind(|| Cli::try_parse_from(&args).map(|_| ()));
+            assert!(parsed.is_ok(), "{args:?} panicked");
+        }
+    }
+}
