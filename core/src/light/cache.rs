@@ -129,6 +129,9 @@ pub fn precompute_cached(
     };
     let key = key(&scene, &settings);
     let path = dir.join(format!("light-{key:016x}.bin"));
+    // Every start tidies: temporary files of processes killed mid-write go,
+    // and the folder keeps to its bound.
+    tidy(dir, &path, size_limit());
     let mut rebuilt = None;
     if let Ok(bytes) = fs::read(&path) {
         match decode(&bytes, key) {
