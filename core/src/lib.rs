@@ -1,7 +1,7 @@
 //! heliodon's core: the science of daylighting, plain Rust without Bevy.
 //!
 //! From the bottom (see ARCHITECTURE.md):
-//! - where and when: [`site`], [`time`];
+//! - where and when: [`site`], [`time`], [`weather`] (EPW files);
 //! - the sun and the skies: [`sun`] (NREL SPA), [`sky`] (gensky, gendaylit,
 //!   CIE, sky patches);
 //! - the model: [`scene`] (scene files, OBJ and MTL, surfaces, patches,
@@ -30,6 +30,7 @@ pub mod sky;
 pub mod sun;
 pub mod sun_pass;
 pub mod time;
+pub mod weather;
 
 /// The glam heliodon's geometry is in (the version Bevy uses).
 pub use glam;

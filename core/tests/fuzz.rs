@@ -1,6 +1,6 @@
 //! Fuzzing the readers with a fixed seed and a bounded number of cases (the
-//! same inputs every run, at any thread count): scene files, OBJ and MTL
-//! mutated from valid ones, byte by byte and with the tokens that broke
+//! same inputs every run, at any thread count): scene files, OBJ, MTL and
+//! EPW weather files mutated from valid ones, byte by byte and with the tokens that broke
 //! readers before (huge and non-finite numbers, byte-order marks, missing
 //! numbers, stray brackets). Every input must give a scene or one error
 //! line, never a panic. Inputs that once crashed are kept below as
@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 use heliodon_core::panel::PanelCatalog;
 use heliodon_core::scene::{SceneReader, load_scene_with};
+use heliodon_core::weather::{HOURS, Weather, calendar};
 
 /// Files served from memory.
 struct Files(HashMap<PathBuf, Vec<u8>>);
@@ -151,5 +152,33 @@ fn inputs_that_once_crashed_stay_fixed() {
     ];
     for (scene, obj, mtl) in cases {
         assert_eq!(survives(&scene, &obj, &mtl), Ok(()), "{mtl}");
+    }
+}
+
+/// A valid EPW year, written here (no file needed).
+fn epw() -> String {
+    let mut text = String::from(
+        "LOCATION,Fuzz,ST,USA,TMY3,1,42.36,-71.06,-5.0,10.0\nDESIGN CONDITIONS,0\nTYPICAL/EXTREME PERIODS,0\nGROUND TEMPERATURES,0\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\nCOMMENTS 1,x\nCOMMENTS 2,y\nDATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n",
+    );
+    for index in 0..HOURS {
+        let (month, day, hour) = calendar(index);
+        text.push_str(&format!("2024,{month},{day},{hour},0,?,1,1,1,1,0,0,0,0,{},{}\n", 50 * (hour % 12), 20 * (hour % 7)));
+    }
+    text
+}
+
+#[test]
+fn mutated_weather_files_never_crash_the_reader() {
+    let good = epw();
+    assert!(Weather::parse_epw(&good, Path::new("fuzz.epw")).is_ok());
+    let mut rng = Rng(15);
+    for case in 0..300 {
+        let text = mutate(&good, &mut rng);
+        let outcome = std::panic::catch_unwind(|| Weather::parse_epw(&text, Path::new("fuzz.epw")));
+        match outcome {
+            Ok(Ok(weather)) => assert_eq!(weather.hours.len(), HOURS, "case {case}"),
+            Ok(Err(e)) => assert!(e.starts_with("fuzz.epw") && !e.contains('\n'), "case {case}: {e}"),
+            Err(_) => panic!("case {case} panicked"),
+        }
     }
 }
