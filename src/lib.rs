@@ -14,7 +14,9 @@ pub mod ecs;
 pub mod render;
 pub mod viewer;
 
-pub use heliodon_core::{BUNDLED_SCENES, bundled_scene, day, light, panel, radiance, report, scene, site, sky, sun, sun_pass, time};
+pub use heliodon_core::{
+    BUNDLED_SCENES, annual, bundled_scene, day, light, panel, radiance, report, scene, site, sky, sun, sun_pass, time, weather,
+};
 
 use bevy::asset::{AssetMetaCheck, AssetPlugin, UnapprovedPathMode};
 

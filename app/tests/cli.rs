@@ -123,7 +123,7 @@ fn help_lists_only_what_exists() {
         .take_while(|l| l.starts_with("  "))
         .filter_map(|l| l.split_whitespace().next())
         .collect();
-    assert_eq!(commands, ["view", "info", "sensors", "export-radiance", "render", "sun", "help"], "{out}");
+    assert_eq!(commands, ["view", "info", "sensors", "export-radiance", "render", "sun", "annual", "help"], "{out}");
 }
 
 // ---- sun -------------------------------------------------------------------------
@@ -372,6 +372,139 @@ fn export_radiance_writes_the_same_model_and_sky() {
     let first_point: usize = index.lines().take(floor).map(|l| l.split(' ').nth(1).unwrap().parse::<usize>().unwrap()).sum();
     let z: f64 = points.lines().nth(first_point).unwrap().split(' ').nth(2).unwrap().parse().unwrap();
     assert!((z - 0.01).abs() < 1e-6, "{z}");
+}
+
+// ---- annual ----------------------------------------------------------------------
+
+/// An EPW at Boston (the bundled scenes' site): dark except the 21st of
+/// March, June, September and December, whose hours get a day of
+/// irradiance; `rows` data rows.
+fn boston_epw(rows: usize) -> String {
+    let mut text = String::from("LOCATION,Boston Logan,MA,USA,TMY3,725090,42.37,-71.01,-5.0,6.0\n");
+    for header in ["DESIGN CONDITIONS,0", "TYPICAL/EXTREME PERIODS,0", "GROUND TEMPERATURES,0", "HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0"] {
+        text += header;
+        text.push('\n');
+    }
+    text += "COMMENTS 1,synthetic\nCOMMENTS 2,\nDATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n";
+    let mut index = 0;
+    for month in 1..=12u32 {
+        for day in 1..=heliodon_core::time::days_in_month(2025, month) {
+            for hour in 1..=24u32 {
+                if index == rows {
+                    return text;
+                }
+                index += 1;
+                let lit = day == 21 && month % 3 == 0 && (6..=20).contains(&hour);
+                let (dni, dhi) = if lit { (60.0 * (hour as f64 - 5.0), 40.0 + 10.0 * (hour % 4) as f64) } else { (0.0, 0.0) };
+                text += &format!("2025,{month},{day},{hour},60,?9?9?9?9E0,10,5,70,101000,0,0,300,0,{dni},{dhi},0,0,0,0,0,0,0,0,0\n");
+            }
+        }
+    }
+    text
+}
+
+/// `annual` on the test room: every hour of `--hourly` is `sensors --sky
+/// perez` at the hour's middle, and DA300 and UDI are the shares of the
+/// occupied hours that file shows.
+#[test]
+fn annual_hours_are_perez_skies_and_the_metrics_count_them() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("annual");
+    std::fs::create_dir_all(&dir).unwrap();
+    let epw = dir.join("boston.epw");
+    std::fs::write(&epw, boston_epw(8760)).unwrap();
+    let hourly = dir.join("hourly.csv");
+    let room = bundled_scene("test_room");
+    let args =
+        ["annual", room.to_str().unwrap(), "--weather", epw.to_str().unwrap(), "--format", "csv", "--hourly", hourly.to_str().unwrap()];
+    let Run { code, out, err } = heliodon(&args, &scratch());
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("far from"), "{err}");
+    let hours: Vec<Vec<String>> =
+        std::fs::read_to_string(&hourly).unwrap().lines().map(|l| l.split(',').map(String::from).collect()).collect();
+    assert_eq!(hours.len(), 8761);
+    let names = &hours[0][3..];
+    let rows: Vec<&str> = out.lines().collect();
+    assert_eq!(rows[0], "name,da300,udi_low,udi,udi_high,ase_hours");
+    assert_eq!(rows.len(), names.len() + 1);
+    let lux = |row: &Vec<String>, s: usize| row[3 + s].parse::<f64>().unwrap();
+    let occupied: Vec<&Vec<String>> = hours[1..].iter().filter(|r| (9..=18).contains(&r[2].parse::<u32>().unwrap())).collect();
+    assert_eq!(occupied.len(), 3650);
+    for (s, row) in rows[1..].iter().enumerate() {
+        let fields: Vec<&str> = row.split(',').collect();
+        assert_eq!(fields[0], names[s]);
+        let share = |keep: &dyn Fn(f64) -> bool| 100.0 * occupied.iter().filter(|r| keep(lux(r, s))).count() as f64 / 3650.0;
+        let da300 = share(&|v| v >= 300.0);
+        assert!((fields[1].parse::<f64>().unwrap() - da300).abs() < 0.06, "{row}: DA300 {da300:.2} from the hours");
+        assert!((fields[3].parse::<f64>().unwrap() - share(&|v| (100.0..=3000.0).contains(&v))).abs() < 0.06, "{row}");
+        // Only the four lit days can give light: at most 40 of 3,650 hours.
+        assert!(da300 > 0.0 && da300 <= 100.0 * 40.0 / 3650.0 + 1e-9, "{row}");
+    }
+    // Dark days read 0; a lit hour is the Perez sky at its middle (21 June, hour 13 → 12:30).
+    assert!(hours[1..].iter().filter(|r| r[1] != "21").all(|r| (0..names.len()).all(|s| lux(r, s) == 0.0)));
+    let june = hours.iter().find(|r| r[0] == "6" && r[1] == "21" && r[2] == "13").unwrap();
+    let args =
+        ["sensors", room.to_str().unwrap(), "--date", "2025-06-21", "--time", "12:30", "--sky", "perez", "--dni", "480", "--dhi", "50"];
+    let Run { code, out, err } = heliodon(&[&args[..], &["--format", "csv"]].concat(), &scratch());
+    assert_eq!(code, 0, "{err}");
+    for (s, line) in out.lines().skip(1).enumerate() {
+        let expected: f64 = line.split(',').nth(1).unwrap().parse().unwrap();
+        assert!(expected > 50.0, "{line}");
+        assert!((lux(june, s) - expected).abs() <= 0.02 * expected, "{}: annual {} against sensors {expected}", names[s], lux(june, s));
+    }
+}
+
+#[test]
+fn annual_refuses_bad_weather_and_scenes_without_sensors_in_one_line() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("annual_errors");
+    std::fs::create_dir_all(&dir).unwrap();
+    let room = bundled_scene("test_room");
+    let truncated = dir.join("truncated.epw");
+    std::fs::write(&truncated, boston_epw(5000)).unwrap();
+    let Run { code, err, .. } = heliodon(&["annual", room.to_str().unwrap(), "--weather", truncated.to_str().unwrap()], &scratch());
+    assert_eq!(code, 1);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("truncated.epw:5008: the file looks truncated: 5000 of 8760 hours"), "{err}");
+    let absent = dir.join("absent.epw");
+    let Run { code, err, .. } = heliodon(&["annual", room.to_str().unwrap(), "--weather", absent.to_str().unwrap()], &scratch());
+    assert_eq!(code, 1);
+    assert!(err.trim_end().lines().count() == 1 && err.contains("absent.epw"), "{err}");
+    let empty = fixture("annual_no_sensors", &scene_toml(""), OBJ);
+    std::fs::write(dir.join("full.epw"), boston_epw(8760)).unwrap();
+    let full = dir.join("full.epw");
+    let Run { code, err, .. } = heliodon(&["annual", empty.scene().to_str().unwrap(), "--weather", full.to_str().unwrap()], &scratch());
+    assert_eq!(code, 1);
+    assert!(err.contains("the scene has no sensors"), "{err}");
+    let Run { code, err, .. } =
+        heliodon(&["annual", room.to_str().unwrap(), "--weather", full.to_str().unwrap(), "--occupied", "18:00-08:00"], &scratch());
+    assert_eq!(code, 2);
+    assert!(err.contains("--occupied") && err.contains("the end is not after the start"), "{err}");
+
+    // Shade groups: checked where they are read; the study refuses them until they are modelled.
+    for file in ["model.obj", "model.mtl"] {
+        std::fs::copy(room.with_file_name(file), dir.join(file)).unwrap();
+    }
+    let base = std::fs::read_to_string(&room).unwrap();
+    let blinds = "\n[materials.blinds]\nkind = \"glass\"\ntransmittance = 0.1\n";
+    let cases = [
+        ("[[shades]]\nwindows = \"glass\"\nshade = \"blinds\"\n", "operable shades are not modelled yet"),
+        ("[[shades]]\nwindows = \"wall\"\nshade = \"blinds\"\n", "shades[0].windows: 'wall' is not a window material (glass or panel)"),
+        ("[[shades]]\nwindows = \"glass\"\nshade = \"curtain\"\n", "shades[0].shade: 'curtain' is not a material of [materials]"),
+    ];
+    for (shades, expected) in cases {
+        std::fs::write(dir.join("scene.toml"), format!("{base}{blinds}\n{shades}")).unwrap();
+        let scene = dir.join("scene.toml");
+        let Run { code, err, .. } = heliodon(&["annual", scene.to_str().unwrap(), "--weather", full.to_str().unwrap()], &scratch());
+        assert_eq!(code, 1, "{err}");
+        assert!(err.lines().filter(|l| l.starts_with("error")).count() == 1 && err.contains(expected), "{shades}: {err}");
+        assert!(!err.contains("no face"), "the shade material is not unused: {err}");
+    }
+    std::fs::write(dir.join("scene.toml"), format!("{base}{blinds}\n{}", cases[0].0)).unwrap();
+    let scene = dir.join("scene.toml");
+    let args = ["annual", scene.to_str().unwrap(), "--weather", full.to_str().unwrap(), "--no-shades", "--format", "json"];
+    let Run { code, out, err } = heliodon(&args, &scratch());
+    assert_eq!(code, 0, "{err}");
+    assert!(out.starts_with("{\"weather\": ") && out.contains("\"sda300_50\": ") && out.contains("\"ase1000_250\": "), "{out}");
+    assert!(!err.contains("no face"), "the shade material is not unused: {err}");
 }
 
 // ---- panels ----------------------------------------------------------------------

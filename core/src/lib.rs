@@ -8,8 +8,9 @@
 //!   sensors);
 //! - complex fenestration: [`panel`] (the API panel crates implement);
 //! - the light engine: [`light`] (daylight coefficients, form factors,
-//!   radiosity, direct sun and panel beams, the cache), and [`day`] (a
-//!   sensor's day and year);
+//!   radiosity, direct sun and panel beams, the cache), [`day`] (a
+//!   sensor's day and year) and [`annual`] (a year of EPW weather: DA,
+//!   UDI, ASE, sDA);
 //! - what the renderer's stencil pass draws: [`sun_pass`];
 //! - the Radiance export: [`radiance`]; CSV and JSON that stay valid
 //!   whatever the names: [`report`].
@@ -19,6 +20,7 @@
 
 #![warn(missing_docs)]
 
+pub mod annual;
 pub mod day;
 pub mod light;
 pub mod panel;

@@ -3,9 +3,11 @@
 //! loading a scene with its warnings, and the precomputation's progress bar.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use crate::light::{LightModel, LightSettings, cache};
 use crate::panel::PanelCatalog;
 use crate::scene::{self, Scene};
 use crate::sky::{Sky, SkyInputs, SkySpec, sky_at};
@@ -96,13 +98,24 @@ pub fn parse_point(text: &str) -> Result<glam::Vec3, String> {
     }
 }
 
-/// The precomputation's progress bar on standard error (indicatif hides it
-/// when standard error is not a terminal); `finish_and_clear` it when done.
-pub fn precompute_progress() -> ProgressBar {
+/// The scene's light model, from the cache unless `no_cache`, with the
+/// precomputation's progress bar on standard error.
+pub fn precompute_for_command(scene: Arc<Scene>, no_cache: bool) -> Result<LightModel, String> {
+    let cache_dir = if no_cache { None } else { cache::default_dir() };
+    let progress = progress_bar("precomputing light");
+    let (model, _) = cache::precompute_cached(scene, LightSettings::default(), cache_dir.as_deref(), &|done| {
+        progress.set_position((done * 1000.0) as u64)
+    })?;
+    progress.finish_and_clear();
+    Ok(model)
+}
+
+/// A progress bar from 0 to 1000 on standard error (indicatif hides it when
+/// standard error is not a terminal); `finish_and_clear` it when done.
+pub fn progress_bar(label: &str) -> ProgressBar {
     let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
-    bar.set_style(
-        ProgressStyle::with_template("precomputing light [{bar:40}] {percent:>3}%").expect("a valid template").progress_chars("#> "),
-    );
+    let template = format!("{label} [{{bar:40}}] {{percent:>3}}%");
+    bar.set_style(ProgressStyle::with_template(&template).expect("a valid template").progress_chars("#> "));
     bar
 }
 

@@ -5,7 +5,7 @@
 //!
 //! - [`args`]: flags shared by several commands (scene case, sky, format);
 //! - [`commands`]: `view`, `info`, `sensors`, `export-radiance`, `render`,
-//!   `sun`.
+//!   `sun`, `annual`.
 
 pub mod args;
 pub mod commands;
@@ -17,6 +17,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::panel::PanelCatalog;
+use commands::annual::AnnualArgs;
 use commands::export_radiance::ExportArgs;
 use commands::render::RenderArgs;
 use commands::sensors::SensorsArgs;
@@ -60,6 +61,8 @@ pub enum Command {
     /// Sun position (NREL SPA) for a site and a local standard time, or the day's sunrise, noon and sunset
     #[command(allow_negative_numbers = true)]
     Sun(SunArgs),
+    /// A year of EPW weather at the sensors: DA300, UDI and ASE hours per sensor, the scene's sDA and ASE
+    Annual(AnnualArgs),
 }
 
 /// Why a command failed: one line for standard error, and the exit code
@@ -127,6 +130,7 @@ pub fn main(panels: PanelCatalog) -> ExitCode {
         Some(Command::Sensors(args)) => done(commands::sensors::run(&args, &panels)),
         Some(Command::ExportRadiance(args)) => done(commands::export_radiance::run(&args, &panels)),
         Some(Command::Render(args)) => done(commands::render::run(&args, &panels)),
+        Some(Command::Annual(args)) => done(commands::annual::run(&args, &panels)),
         Some(Command::Sun(args)) => {
             commands::sun::run(&args);
             Ok(ExitCode::SUCCESS)
@@ -153,6 +157,9 @@ mod tests {
             "info",
             "view",
             "export-radiance",
+            "annual",
+            "--weather",
+            "--occupied",
             "--date",
             "--time",
             "--sky",

@@ -28,6 +28,8 @@ pub struct SceneFile {
     pub sensor_grids: Vec<Spanned<SensorGridTable>>,
     #[serde(default)]
     pub cameras: Vec<Spanned<CameraTable>>,
+    #[serde(default)]
+    pub shades: Vec<Spanned<ShadeTable>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -93,6 +95,14 @@ pub struct CameraTable {
     pub fov: Option<Spanned<f64>>,
 }
 
+/// An operable shade group (IES LM-83, the contract's `[[shades]]`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShadeTable {
+    pub windows: Spanned<String>,
+    pub shade: Spanned<String>,
+}
+
 /// The scene file after schema and range checks of its site, model and
 /// lighting tables; materials and sensors are checked where they are built.
 #[derive(Debug)]
@@ -111,6 +121,7 @@ pub struct ParsedScene {
     pub sensors: Vec<Spanned<SensorTable>>,
     pub sensor_grids: Vec<Spanned<SensorGridTable>>,
     pub cameras: Vec<Spanned<CameraTable>>,
+    pub shades: Vec<Spanned<ShadeTable>>,
 }
 
 impl ParsedScene {
@@ -181,6 +192,7 @@ pub fn parse(path: &Path, text: &str) -> Result<ParsedScene, SceneError> {
         sensors: file.sensors,
         sensor_grids: file.sensor_grids,
         cameras: file.cameras,
+        shades: file.shades,
     };
     parsed.name = file.name.unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
     parsed.site = site(&parsed, file.site.get_ref())?;

@@ -107,8 +107,10 @@ pub fn resolve(
     }
     let used: BTreeSet<Option<usize>> = model.meshes.iter().map(|m| m.mesh.material_id).collect();
     let used_names: BTreeSet<&str> = used.iter().flatten().map(|&i| model.materials[i].name.as_str()).collect();
+    // Shade materials are drawn only when a shade is down (see `shades`).
+    let shade_names: BTreeSet<&str> = parsed.shades.iter().map(|s| s.get_ref().shade.get_ref().as_str()).collect();
     for (name, table) in &parsed.materials {
-        if !used_names.contains(name.as_str()) {
+        if !used_names.contains(name.as_str()) && !shade_names.contains(name.as_str()) {
             warnings.push(SceneWarning {
                 location: parsed.at(table.span(), format!("materials.{name}")),
                 message: format!("no face of {} uses material '{name}'", obj_path.display()),
@@ -148,7 +150,12 @@ pub fn resolve(
     Ok((materials, index))
 }
 
-fn scene_material(parsed: &ParsedScene, name: &str, table: &Spanned<MaterialTable>, panels: &PanelCatalog) -> Result<Material, SceneError> {
+pub(super) fn scene_material(
+    parsed: &ParsedScene,
+    name: &str,
+    table: &Spanned<MaterialTable>,
+    panels: &PanelCatalog,
+) -> Result<Material, SceneError> {
     let key = |k: &str| format!("materials.{name}.{k}");
     let entries = table.get_ref();
     let Some(kind) = entries.get("kind") else {

@@ -16,6 +16,7 @@ mod polygon;
 mod repair;
 pub(crate) use patches::clip as clip_convex;
 mod sensors;
+mod shades;
 mod surfaces;
 
 use std::future::Future;
@@ -30,6 +31,7 @@ pub use frame::{ModelFrame, UpAxis};
 pub use material::{Material, MaterialKind, MaterialOrigin, Rgb};
 pub use patches::{Patch, PatchMesh, PatchSizing};
 pub use sensors::{DEFAULT_FOV, Sensor, Viewpoint};
+pub use shades::ShadeGroup;
 
 use crate::panel::PanelCatalog;
 use crate::site::Site;
@@ -89,6 +91,8 @@ pub struct Scene {
     pub sensors: Vec<Sensor>,
     /// Named camera positions (`[[cameras]]`).
     pub viewpoints: Vec<Viewpoint>,
+    /// Operable shades (`[[shades]]`), for the annual study.
+    pub shades: Vec<ShadeGroup>,
     /// Axis-aligned bounds of all triangles: (min, max).
     pub bounds: (Vec3, Vec3),
     /// The bounds of what the scene is about: its windows and sensors (the
@@ -251,6 +255,7 @@ fn build(
     let mut warnings = Vec::new();
     let model = obj::import(&obj_path, obj_text, &obj_scan, &mtls)?;
     let (materials, material_of) = material::resolve(&parsed, &model, panels, &obj_path, &mut warnings)?;
+    let shades = shades::shade_groups(&parsed, &materials, panels)?;
     // A model in survey coordinates is recentred, in f64, before anything
     // becomes f32 (which keeps millimetres only within a few km of 0).
     if let Some(centre) = obj::far_centre(&model, RECENTRE_BEYOND) {
@@ -339,6 +344,7 @@ fn build(
             patches,
             sensors,
             viewpoints,
+            shades,
             bounds,
             focus,
         },

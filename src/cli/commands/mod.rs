@@ -2,6 +2,7 @@
 //! has its flags (a clap `Args` struct) and a `run` that prints its output
 //! or returns a [`super::CliError`].
 
+pub mod annual;
 pub mod export_radiance;
 pub mod info;
 pub mod render;

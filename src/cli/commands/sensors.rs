@@ -5,8 +5,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use crate::cli::CliError;
-use crate::cli::args::{Format, SkyArgs, load_for_command, precompute_progress, sky_for};
-use crate::light::{LightSettings, Lighting, cache};
+use crate::cli::args::{Format, SkyArgs, load_for_command, precompute_for_command, sky_for};
+use crate::light::Lighting;
 use crate::panel::PanelCatalog;
 use crate::report::{csv_field, json_string};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
@@ -40,12 +40,7 @@ pub fn run(args: &SensorsArgs, panels: &PanelCatalog) -> Result<(), CliError> {
 pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, String> {
     let spec = args.sky.spec()?;
     let scene = std::sync::Arc::new(load_for_command(&args.scene, panels)?);
-    let cache_dir = if args.no_cache { None } else { cache::default_dir() };
-    let progress = precompute_progress();
-    let (model, _) = cache::precompute_cached(scene.clone(), LightSettings::default(), cache_dir.as_deref(), &|done| {
-        progress.set_position((done * 1000.0) as u64)
-    })?;
-    progress.finish_and_clear();
+    let model = precompute_for_command(scene.clone(), args.no_cache)?;
     // Sensors in the open: outside every room, or a model without one.
     const OUTSIDE: f64 = 0.3;
     let outside: Vec<&str> =

@@ -1,0 +1,264 @@
+//! A year of weather on a scene: daylight autonomy (DA300), useful daylight
+//! illuminance (UDI 100-3000) and annual sunlight exposure (ASE1000) per
+//! sensor, and the scene's sDA300/50% and ASE1000/250 (IES LM-83), as the
+//! contract's "Annual climate-based daylight" defines them.
+//!
+//! How it works, for now:
+//! 1. Each EPW hour (ending at `h`) is evaluated at `h − 0.5` local standard
+//!    time, under the Perez all-weather sky of its direct normal and diffuse
+//!    horizontal irradiance: the same sky `sensors --sky perez --dni --dhi`
+//!    makes, so the two agree hour by hour.
+//! 2. Hours with the sun below the horizon, no diffuse light or no sky that
+//!    can be made read 0 lux.
+//! 3. Every lit hour is one relight of the precomputed model (direct sky
+//!    from daylight coefficients, exact sun rays and panel lobes, the
+//!    radiosity warm-started from the hour before). Days run in parallel,
+//!    each day's hours in order, so the numbers do not depend on the thread
+//!    count.
+//! 4. ASE counts the direct sun alone (no sky, no interreflection).
+//!
+//! This is the plain path: one radiosity solve per lit hour (about 4,400 a
+//! year). Indirect daylight coefficients per sky bin, which would make the
+//! year a few matrix products, and LM-83 operable shades are not built yet.
+
+use crate::light::{LightModel, Lighting, par_map};
+use crate::site::Site;
+use crate::sky::{Sky, SkyError, SkySpec, perez, sky_at};
+use crate::time::{Date, LocalDateTime, TimeOfDay};
+use crate::weather::{HOURS, Weather};
+
+/// The year the 365-day calendar's dates are placed in for sun positions
+/// (not a leap year; the EPW's own year column is ignored).
+const CALENDAR_YEAR: i32 = 2025;
+
+/// DA's threshold, lux.
+pub const DA_LUX: f64 = 300.0;
+/// UDI's band, lux: below is too little, above too much.
+pub const UDI_BAND: (f64, f64) = (100.0, 3000.0);
+/// ASE's threshold of direct sun, lux.
+pub const ASE_LUX: f64 = 1000.0;
+/// sDA: a sensor counts when its DA300 reaches this share of hours, %.
+pub const SDA_SHARE: f64 = 50.0;
+/// ASE1000/250: a sensor counts with at least these hours of direct sun.
+pub const ASE_HOURS: usize = 250;
+
+/// Occupied hours of each day: an EPW hour counts when its middle
+/// (`h − 0.5`) lies in `[start, end)`, hours after midnight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Occupancy {
+    /// Start, hours after midnight.
+    pub start: f64,
+    /// End, hours after midnight.
+    pub end: f64,
+}
+
+impl Default for Occupancy {
+    /// 08:00-18:00: EPW hours 9 to 18, 3,650 hours a year.
+    fn default() -> Self {
+        Self { start: 8.0, end: 18.0 }
+    }
+}
+
+impl Occupancy {
+    /// Parses `HH:MM-HH:MM` (the end after the start).
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let (start, end) = text.split_once('-').ok_or_else(|| format!("'{text}' is not HH:MM-HH:MM"))?;
+        let start = TimeOfDay::parse(start)?.hours();
+        let end = TimeOfDay::parse(end)?.hours();
+        if end <= start {
+            return Err(format!("'{text}': the end is not after the start"));
+        }
+        Ok(Self { start, end })
+    }
+
+    /// Whether EPW hour `hour` (1-24, ending at `hour`) is occupied.
+    pub fn contains(&self, hour: u32) -> bool {
+        let middle = hour as f64 - 0.5;
+        (self.start..self.end).contains(&middle)
+    }
+}
+
+/// One sensor's year.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SensorYear {
+    /// The sensor's name.
+    pub name: String,
+    /// % of occupied hours with at least [`DA_LUX`].
+    pub da300: f64,
+    /// % of occupied hours below [`UDI_BAND`].0.
+    pub udi_low: f64,
+    /// % of occupied hours within [`UDI_BAND`].
+    pub udi: f64,
+    /// % of occupied hours above [`UDI_BAND`].1.
+    pub udi_high: f64,
+    /// Occupied hours with at least [`ASE_LUX`] of direct sun.
+    pub ase_hours: usize,
+}
+
+/// A year's result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AnnualResult {
+    /// Per sensor of the scene, in its order.
+    pub sensors: Vec<SensorYear>,
+    /// Occupied hours of the year.
+    pub occupied_hours: usize,
+    /// Lit hours whose sky could not be made (they read 0).
+    pub skipped_hours: usize,
+    /// Total lux of every sensor for every hour, `[hour][sensor]`, when asked for.
+    pub hourly: Option<Vec<Vec<f32>>>,
+}
+
+impl AnnualResult {
+    /// sDA300/50%: % of sensors with DA300 ≥ 50%.
+    pub fn sda(&self) -> f64 {
+        share(&self.sensors, |s| s.da300 >= SDA_SHARE)
+    }
+
+    /// ASE1000/250: % of sensors with at least 250 hours of direct sun ≥ 1000 lux.
+    pub fn ase(&self) -> f64 {
+        share(&self.sensors, |s| s.ase_hours >= ASE_HOURS)
+    }
+}
+
+fn share(sensors: &[SensorYear], counts: impl Fn(&SensorYear) -> bool) -> f64 {
+    if sensors.is_empty() {
+        return 0.0;
+    }
+    100.0 * sensors.iter().filter(|s| counts(s)).count() as f64 / sensors.len() as f64
+}
+
+/// One day: each hour's (total, direct sun) lux per sensor, `None` when
+/// dark; and how many lit hours had no sky.
+type DayResult = (Vec<Option<Vec<(f32, f32)>>>, usize);
+
+/// The local time an EPW hour is evaluated at: its middle.
+pub fn hour_time(month: u32, day: u32, hour: u32) -> LocalDateTime {
+    LocalDateTime {
+        date: Date::new(CALENDAR_YEAR, month, day).expect("a day of the 365-day calendar"),
+        time: TimeOfDay::from_hours(hour as f64 - 0.5).expect("an hour of the day"),
+    }
+}
+
+/// The Perez sky of one EPW hour at the site, or `None` when the hour is
+/// dark (sun below the horizon, no diffuse light); an error when the hour is
+/// lit but its sky cannot be made.
+pub fn hour_sky(site: &Site, when: &LocalDateTime, direct_normal: f64, diffuse_horizontal: f64) -> Result<Option<Sky>, SkyError> {
+    let spec = SkySpec::Perez(perez::Input::Irradiance { direct_normal, diffuse_horizontal });
+    let (sun, sky) = sky_at(site, &spec, when);
+    if sun.altitude <= 0.0 || diffuse_horizontal <= 0.0 {
+        return Ok(None);
+    }
+    sky.map(Some)
+}
+
+/// Runs the year. `keep_hourly` keeps every hour's total lux (8,760 ×
+/// sensors values); `progress` hears the share of days done (from any thread).
+pub fn annual(
+    model: &LightModel,
+    site: &Site,
+    weather: &Weather,
+    occupancy: Occupancy,
+    keep_hourly: bool,
+    progress: &(dyn Fn(f64) + Sync),
+) -> AnnualResult {
+    let sensor_count = model.scene.sensors.len();
+    let days = HOURS / 24;
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let year: Vec<DayResult> = par_map(None, days, |day| {
+        let mut previous: Option<Lighting> = None;
+        let mut skipped = 0;
+        let hours = (0..24)
+            .map(|k| {
+                let hour = &weather.hours[day * 24 + k];
+                let when = hour_time(hour.month, hour.day, hour.hour);
+                let sky = match hour_sky(site, &when, hour.direct_normal, hour.diffuse_horizontal) {
+                    Ok(Some(sky)) => sky,
+                    Ok(None) => return None,
+                    Err(_) => {
+                        skipped += 1;
+                        return None;
+                    }
+                };
+                let lighting = model.solve(&sky, previous.as_ref());
+                let values = lighting.sensors.iter().map(|r| (r.total as f32, r.direct_sun as f32)).collect();
+                previous = Some(lighting);
+                Some(values)
+            })
+            .collect();
+        let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        progress(finished as f64 / days as f64);
+        (hours, skipped)
+    });
+
+    let mut counts = vec![[0usize; 5]; sensor_count]; // da, udi_low, udi, udi_high, ase
+    let mut occupied_hours = 0;
+    for (index, hour) in year.iter().flat_map(|(hours, _)| hours).enumerate() {
+        if !occupancy.contains(weather.hours[index].hour) {
+            continue;
+        }
+        occupied_hours += 1;
+        for (s, count) in counts.iter_mut().enumerate() {
+            let (total, sun) = hour.as_ref().map_or((0.0, 0.0), |values| (values[s].0 as f64, values[s].1 as f64));
+            count[0] += usize::from(total >= DA_LUX);
+            count[1] += usize::from(total < UDI_BAND.0);
+            count[2] += usize::from((UDI_BAND.0..=UDI_BAND.1).contains(&total));
+            count[3] += usize::from(total > UDI_BAND.1);
+            count[4] += usize::from(sun >= ASE_LUX);
+        }
+    }
+    let percent = |n: usize| if occupied_hours == 0 { 0.0 } else { 100.0 * n as f64 / occupied_hours as f64 };
+    let sensors = model
+        .scene
+        .sensors
+        .iter()
+        .zip(&counts)
+        .map(|(sensor, c)| SensorYear {
+            name: sensor.name.clone(),
+            da300: percent(c[0]),
+            udi_low: percent(c[1]),
+            udi: percent(c[2]),
+            udi_high: percent(c[3]),
+            ase_hours: c[4],
+        })
+        .collect();
+    let skipped_hours = year.iter().map(|(_, skipped)| skipped).sum();
+    let hourly = keep_hourly.then(|| {
+        year.iter()
+            .flat_map(|(hours, _)| hours)
+            .map(|hour| hour.as_ref().map_or_else(|| vec![0.0; sensor_count], |values| values.iter().map(|v| v.0).collect()))
+            .collect()
+    });
+    AnnualResult { sensors, occupied_hours, skipped_hours, hourly }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_occupancy_is_epw_hours_9_to_18() {
+        let occupied: Vec<u32> = (1..=24).filter(|&h| Occupancy::default().contains(h)).collect();
+        assert_eq!(occupied, (9..=18).collect::<Vec<_>>());
+        let evening = Occupancy::parse("17:00-21:30").unwrap();
+        assert_eq!((1..=24).filter(|&h| evening.contains(h)).collect::<Vec<_>>(), vec![18, 19, 20, 21]);
+        assert!(Occupancy::parse("18:00-08:00").is_err());
+        assert!(Occupancy::parse("8-18").is_err());
+    }
+
+    #[test]
+    fn hours_are_evaluated_at_their_middle() {
+        let when = hour_time(6, 21, 13);
+        assert_eq!((when.date.month, when.date.day), (6, 21));
+        assert_eq!(when.time.hours(), 12.5);
+    }
+
+    #[test]
+    fn dark_hours_have_no_sky() {
+        let site = Site::new(41.98, -87.92, -6.0);
+        let night = hour_time(1, 15, 2);
+        assert!(matches!(hour_sky(&site, &night, 0.0, 50.0), Ok(None)));
+        let noon = hour_time(6, 21, 13);
+        assert!(matches!(hour_sky(&site, &noon, 700.0, 0.0), Ok(None)));
+        assert!(matches!(hour_sky(&site, &noon, 700.0, 200.0), Ok(Some(_))));
+    }
+}

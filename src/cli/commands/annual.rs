@@ -1,0 +1,165 @@
+//! `heliodon annual`: a year of EPW weather on the scene's sensors (DA300,
+//! UDI, ASE hours, sDA, ASE), from one (cached) precomputation.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use crate::annual::{AnnualResult, Occupancy, annual, hour_time};
+use crate::cli::CliError;
+use crate::cli::args::{Format, load_for_command, precompute_for_command, progress_bar};
+use crate::panel::PanelCatalog;
+use crate::report::{csv_field, json_string};
+use crate::sun::solar_position;
+use crate::weather::Weather;
+
+#[derive(clap::Args, Debug)]
+pub struct AnnualArgs {
+    /// Scene file (TOML)
+    pub scene: PathBuf,
+    /// Weather file (EnergyPlus EPW)
+    #[arg(long, value_name = "FILE.epw")]
+    pub weather: PathBuf,
+    /// Occupied hours, local standard time
+    #[arg(long, value_name = "HH:MM-HH:MM", value_parser = Occupancy::parse, default_value = "08:00-18:00")]
+    pub occupied: Occupancy,
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    pub format: Format,
+    /// Also write every sensor's total lux for every hour (8,760 rows) to this CSV file
+    #[arg(long, value_name = "FILE.csv")]
+    pub hourly: Option<PathBuf>,
+    /// Ignore the scene's [[shades]] (operable shades are not modelled yet: without this flag a scene with shades is refused)
+    #[arg(long)]
+    pub no_shades: bool,
+    /// Neither read nor write the precomputation cache
+    #[arg(long)]
+    pub no_cache: bool,
+}
+
+/// Runs the year and prints the per-sensor metrics.
+pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
+    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels)?);
+    if scene.sensors.is_empty() {
+        return Err(CliError::failure(format!(
+            "{}: the scene has no sensors; an annual study reads sensors ([[sensors]] or [[sensor_grids]])",
+            args.scene.display()
+        )));
+    }
+    if !scene.shades.is_empty() && !args.no_shades {
+        return Err(CliError::failure(format!(
+            "{}: [[shades]]: operable shades are not modelled yet; --no-shades counts every hour with the windows as modelled",
+            args.scene.display()
+        )));
+    }
+    let text = std::fs::read_to_string(&args.weather).map_err(|e| format!("{}: {e}", args.weather.display()))?;
+    let weather = Weather::parse_epw(&text, &args.weather)?;
+    let station = &weather.station;
+    let site = &scene.site;
+    if (station.latitude - site.latitude).abs() > 1.0
+        || (station.longitude - site.longitude).abs() > 1.0
+        || (station.timezone - site.timezone).abs() >= 1.0
+    {
+        eprintln!(
+            "warning: {}: the weather of {} ({:.2}°, {:.2}°, UTC{:+}) is far from the scene's site ({:.2}°, {:.2}°, UTC{:+}); the site's sun is used",
+            args.weather.display(),
+            station.name,
+            station.latitude,
+            station.longitude,
+            station.timezone,
+            site.latitude,
+            site.longitude,
+            site.timezone
+        );
+    }
+    let missing_in_daylight =
+        weather.hours.iter().filter(|h| h.missing && solar_position(site, &hour_time(h.month, h.day, h.hour)).altitude > 0.0).count();
+    if missing_in_daylight > 0 {
+        eprintln!(
+            "warning: {}: {missing_in_daylight} daylight hours have no direct or diffuse irradiance (9999); their missing values are taken as 0",
+            args.weather.display()
+        );
+    }
+
+    let model = precompute_for_command(scene.clone(), args.no_cache)?;
+    let progress = progress_bar("a year of hours");
+    let result =
+        annual(&model, site, &weather, args.occupied, args.hourly.is_some(), &|done| progress.set_position((done * 1000.0) as u64));
+    progress.finish_and_clear();
+    if result.skipped_hours > 0 {
+        eprintln!("warning: {}: {} lit hours gave no Perez sky; they read 0 lux", args.weather.display(), result.skipped_hours);
+    }
+    if let Some(path) = &args.hourly {
+        std::fs::write(path, hourly_csv(&result, &weather)).map_err(|e| format!("--hourly {}: {e}", path.display()))?;
+    }
+    print!("{}", report(&result, args.format, &args.weather));
+    Ok(())
+}
+
+fn hourly_csv(result: &AnnualResult, weather: &Weather) -> String {
+    let mut out = String::from("month,day,hour");
+    for sensor in &result.sensors {
+        out.push(',');
+        out.push_str(&csv_field(&sensor.name));
+    }
+    out.push('\n');
+    for (hour, values) in weather.hours.iter().zip(result.hourly.iter().flatten()) {
+        let _ = write!(out, "{},{},{}", hour.month, hour.day, hour.hour);
+        for value in values {
+            let _ = write!(out, ",{value:.1}");
+        }
+        out.push('\n');
+    }
+    out
+}
+
+fn report(result: &AnnualResult, format: Format, weather_path: &std::path::Path) -> String {
+    let mut out = String::new();
+    match format {
+        Format::Csv => {
+            out.push_str("name,da300,udi_low,udi,udi_high,ase_hours\n");
+            for s in &result.sensors {
+                let _ =
+                    writeln!(out, "{},{:.1},{:.1},{:.1},{:.1},{}", csv_field(&s.name), s.da300, s.udi_low, s.udi, s.udi_high, s.ase_hours);
+            }
+        }
+        Format::Json => {
+            let rows: Vec<String> = result
+                .sensors
+                .iter()
+                .map(|s| {
+                    format!(
+                        "{{\"name\": {}, \"da300\": {:.1}, \"udi_low\": {:.1}, \"udi\": {:.1}, \"udi_high\": {:.1}, \"ase_hours\": {}}}",
+                        json_string(&s.name),
+                        s.da300,
+                        s.udi_low,
+                        s.udi,
+                        s.udi_high,
+                        s.ase_hours
+                    )
+                })
+                .collect();
+            let _ = writeln!(
+                out,
+                "{{\"weather\": {}, \"occupied_hours\": {}, \"sda300_50\": {:.1}, \"ase1000_250\": {:.1}, \"sensors\": [{}]}}",
+                json_string(&weather_path.display().to_string()),
+                result.occupied_hours,
+                result.sda(),
+                result.ase(),
+                rows.join(", ")
+            );
+        }
+        Format::Table => {
+            let _ = writeln!(out, "{}: {} occupied hours", weather_path.display(), result.occupied_hours);
+            let _ = writeln!(out, "sDA300/50%  {:.1}% of sensors", result.sda());
+            let _ = writeln!(out, "ASE1000/250 {:.1}% of sensors", result.ase());
+            let _ = writeln!(out, "{:<20} {:>7} {:>8} {:>7} {:>9} {:>9}", "sensor", "DA300 %", "UDI<100", "UDI %", "UDI>3000", "ASE h");
+            for s in &result.sensors {
+                let _ = writeln!(
+                    out,
+                    "{:<20} {:>7.1} {:>8.1} {:>7.1} {:>9.1} {:>9}",
+                    s.name, s.da300, s.udi_low, s.udi, s.udi_high, s.ase_hours
+                );
+            }
+        }
+    }
+    out
+}
