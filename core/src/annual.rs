@@ -12,9 +12,11 @@
 //!    can be made read 0 lux.
 //! 3. Every lit hour is one relight of the precomputed model (direct sky
 //!    from daylight coefficients, exact sun rays and panel lobes, the
-//!    radiosity warm-started from the hour before). Days run in parallel,
-//!    each day's hours in order, so the numbers do not depend on the thread
-//!    count.
+//!    radiosity warm-started from the hour before). Runs of whole days go
+//!    in parallel, each day's hours in order from a cold start, so the
+//!    numbers do not depend on the thread count; occupied hours are counted
+//!    as they come (memory follows sensors, not hours, unless every hour is
+//!    kept for `--hourly`).
 //! 4. ASE counts the direct sun alone (no sky, no interreflection).
 //!
 //! This is the plain path: one radiosity solve per lit hour (about 4,400 a
@@ -127,9 +129,44 @@ fn share(sensors: &[SensorYear], counts: impl Fn(&SensorYear) -> bool) -> f64 {
     100.0 * sensors.iter().filter(|s| counts(s)).count() as f64 / sensors.len() as f64
 }
 
-/// One day: each hour's (total, direct sun) lux per sensor, `None` when
-/// dark; and how many lit hours had no sky.
-type DayResult = (Vec<Option<Vec<(f32, f32)>>>, usize);
+/// Occupied hours counted per sensor: DA300, UDI low, UDI, UDI high, ASE.
+#[derive(Debug, Clone, Default)]
+struct Tally {
+    counts: Vec<[u32; 5]>,
+    occupied: usize,
+    skipped: usize,
+}
+
+impl Tally {
+    fn new(sensors: usize) -> Self {
+        Self { counts: vec![[0; 5]; sensors], ..Default::default() }
+    }
+
+    /// One occupied hour: each sensor's (total, direct sun) lux; `None` when dark.
+    fn count(&mut self, readings: Option<&[(f64, f64)]>) {
+        self.occupied += 1;
+        for (s, count) in self.counts.iter_mut().enumerate() {
+            let (total, sun) = readings.map_or((0.0, 0.0), |r| r[s]);
+            count[0] += u32::from(total >= DA_LUX);
+            count[1] += u32::from(total < UDI_BAND.0);
+            count[2] += u32::from((UDI_BAND.0..=UDI_BAND.1).contains(&total));
+            count[3] += u32::from(total > UDI_BAND.1);
+            count[4] += u32::from(sun >= ASE_LUX);
+        }
+    }
+
+    /// Counts are whole numbers: merging in any order gives the same tally.
+    fn merge(mut self, other: &Tally) -> Self {
+        for (mine, theirs) in self.counts.iter_mut().zip(&other.counts) {
+            for (a, b) in mine.iter_mut().zip(theirs) {
+                *a += b;
+            }
+        }
+        self.occupied += other.occupied;
+        self.skipped += other.skipped;
+        self
+    }
+}
 
 /// The local time an EPW hour is evaluated at: its middle.
 pub fn hour_time(month: u32, day: u32, hour: u32) -> LocalDateTime {
@@ -164,71 +201,58 @@ pub fn annual(
     let sensor_count = model.scene.sensors.len();
     let days = HOURS / 24;
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let year: Vec<DayResult> = par_map(None, days, |day| {
-        let mut previous: Option<Lighting> = None;
-        let mut skipped = 0;
-        let hours = (0..24)
-            .map(|k| {
-                let hour = &weather.hours[day * 24 + k];
+    // Runs of whole days, one per core: memory follows sensors × cores, not
+    // hours (unless every hour is kept). Each day starts cold, so the split
+    // does not change a number.
+    let runs = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let year: Vec<(Tally, Vec<Vec<f32>>)> = par_map(None, runs, |run| {
+        let mut tally = Tally::new(sensor_count);
+        let mut hourly = Vec::new();
+        for day in run * days / runs..(run + 1) * days / runs {
+            let mut previous: Option<Lighting> = None;
+            for hour in &weather.hours[day * 24..day * 24 + 24] {
                 let when = hour_time(hour.month, hour.day, hour.hour);
-                let sky = match hour_sky(site, &when, hour.direct_normal, hour.diffuse_horizontal) {
-                    Ok(Some(sky)) => sky,
-                    Ok(None) => return None,
-                    Err(_) => {
-                        skipped += 1;
-                        return None;
-                    }
-                };
-                let lighting = model.solve(&sky, previous.as_ref());
-                let values = lighting.sensors.iter().map(|r| (r.total as f32, r.direct_sun as f32)).collect();
-                previous = Some(lighting);
-                Some(values)
-            })
-            .collect();
-        let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-        progress(finished as f64 / days as f64);
-        (hours, skipped)
+                let sky = hour_sky(site, &when, hour.direct_normal, hour.diffuse_horizontal).unwrap_or_else(|_| {
+                    tally.skipped += 1;
+                    None
+                });
+                let readings: Option<Vec<(f64, f64)>> = sky.map(|sky| {
+                    let lighting = model.solve(&sky, previous.as_ref());
+                    let readings = lighting.sensors.iter().map(|r| (r.total, r.direct_sun)).collect();
+                    previous = Some(lighting);
+                    readings
+                });
+                if occupancy.contains(hour.hour) {
+                    tally.count(readings.as_deref());
+                }
+                if keep_hourly {
+                    hourly.push(readings.map_or_else(|| vec![0.0; sensor_count], |r| r.iter().map(|v| v.0 as f32).collect()));
+                }
+            }
+            let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(finished as f64 / days as f64);
+        }
+        (tally, hourly)
     });
-
-    let mut counts = vec![[0usize; 5]; sensor_count]; // da, udi_low, udi, udi_high, ase
-    let mut occupied_hours = 0;
-    for (index, hour) in year.iter().flat_map(|(hours, _)| hours).enumerate() {
-        if !occupancy.contains(weather.hours[index].hour) {
-            continue;
-        }
-        occupied_hours += 1;
-        for (s, count) in counts.iter_mut().enumerate() {
-            let (total, sun) = hour.as_ref().map_or((0.0, 0.0), |values| (values[s].0 as f64, values[s].1 as f64));
-            count[0] += usize::from(total >= DA_LUX);
-            count[1] += usize::from(total < UDI_BAND.0);
-            count[2] += usize::from((UDI_BAND.0..=UDI_BAND.1).contains(&total));
-            count[3] += usize::from(total > UDI_BAND.1);
-            count[4] += usize::from(sun >= ASE_LUX);
-        }
-    }
-    let percent = |n: usize| if occupied_hours == 0 { 0.0 } else { 100.0 * n as f64 / occupied_hours as f64 };
+    let tally = year.iter().fold(Tally::new(sensor_count), |sum, (run, _)| sum.merge(run));
+    let occupied_hours = tally.occupied;
+    let percent = |n: u32| if occupied_hours == 0 { 0.0 } else { 100.0 * f64::from(n) / occupied_hours as f64 };
     let sensors = model
         .scene
         .sensors
         .iter()
-        .zip(&counts)
+        .zip(&tally.counts)
         .map(|(sensor, c)| SensorYear {
             name: sensor.name.clone(),
             da300: percent(c[0]),
             udi_low: percent(c[1]),
             udi: percent(c[2]),
             udi_high: percent(c[3]),
-            ase_hours: c[4],
+            ase_hours: c[4] as usize,
         })
         .collect();
-    let skipped_hours = year.iter().map(|(_, skipped)| skipped).sum();
-    let hourly = keep_hourly.then(|| {
-        year.iter()
-            .flat_map(|(hours, _)| hours)
-            .map(|hour| hour.as_ref().map_or_else(|| vec![0.0; sensor_count], |values| values.iter().map(|v| v.0).collect()))
-            .collect()
-    });
-    AnnualResult { sensors, occupied_hours, skipped_hours, hourly }
+    let hourly = keep_hourly.then(|| year.into_iter().flat_map(|(_, hours)| hours).collect());
+    AnnualResult { sensors, occupied_hours, skipped_hours: tally.skipped, hourly }
 }
 
 #[cfg(test)]
