@@ -31,6 +31,19 @@ fn bundled_scene(name: &str) -> PathBuf {
     root().join("assets/scenes").join(name).join("scene.toml")
 }
 
+/// The bundled test room copied into `folder` (under the test target's
+/// temporary folder), its scene file ending with `extra`; the scene's path.
+fn test_room_with(folder: &str, extra: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(folder);
+    std::fs::create_dir_all(&dir).unwrap();
+    let room = bundled_scene("test_room");
+    for file in ["model.obj", "model.mtl"] {
+        std::fs::copy(room.with_file_name(file), dir.join(file)).unwrap();
+    }
+    std::fs::write(dir.join("scene.toml"), std::fs::read_to_string(&room).unwrap() + extra).unwrap();
+    dir.join("scene.toml")
+}
+
 fn load(path: &Path) -> Arc<Scene> {
     Arc::new(load_scene(path, &PanelCatalog::new()).unwrap().scene)
 }
@@ -241,16 +254,10 @@ fn sensors_command_prints_the_contract_csv_and_shares_one_precomputation() {
 /// in one warning line; the command still answers.
 #[test]
 fn sensors_in_the_open_are_warned_about() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sensor_outside");
-    std::fs::create_dir_all(&dir).unwrap();
-    let room = bundled_scene("test_room");
-    for file in ["model.obj", "model.mtl"] {
-        std::fs::copy(room.with_file_name(file), dir.join(file)).unwrap();
-    }
-    let text = std::fs::read_to_string(&room).unwrap()
-        + "\n[[sensors]]\nname = \"in-the-garden\"\nposition = [2.0, -12.0, 0.8]\nnormal = [0.0, 0.0, 1.0]\n";
-    std::fs::write(dir.join("scene.toml"), text).unwrap();
-    let scene = dir.join("scene.toml");
+    let scene = test_room_with(
+        "sensor_outside",
+        "\n[[sensors]]\nname = \"in-the-garden\"\nposition = [2.0, -12.0, 0.8]\nnormal = [0.0, 0.0, 1.0]\n",
+    );
     let args = ["sensors", scene.to_str().unwrap(), "--date", "2026-03-21", "--time", "12:00", "--format", "csv"];
     let Run { code, out, err } = heliodon(&args, &scratch());
     assert_eq!(code, 0, "{err}");
@@ -274,16 +281,8 @@ fn sensors_in_the_open_are_warned_about() {
 /// the CSV (RFC 4180), the JSON and the Radiance export valid.
 #[test]
 fn odd_sensor_names_keep_every_output_valid() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("odd_names");
-    std::fs::create_dir_all(&dir).unwrap();
-    let room = bundled_scene("test_room");
-    for file in ["model.obj", "model.mtl"] {
-        std::fs::copy(room.with_file_name(file), dir.join(file)).unwrap();
-    }
     let sensor = |name: &str| format!("\n[[sensors]]\nname = \"{name}\"\nposition = [2.0, 3.0, 0.8]\nnormal = [0.0, 0.0, 1.0]\n");
-    let text = std::fs::read_to_string(&room).unwrap() + &sensor(r#"desk, \"north\""#) + &sensor(r"two\nlines") + &sensor(r"bell\u0007");
-    std::fs::write(dir.join("scene.toml"), text).unwrap();
-    let scene = dir.join("scene.toml");
+    let scene = test_room_with("odd_names", &(sensor(r#"desk, \"north\""#) + &sensor(r"two\nlines") + &sensor(r"bell\u0007")));
     let case = ["--date", "2026-03-21", "--time", "12:00", "--sky", "overcast"];
     let run = |format: &str| heliodon(&[&["sensors", scene.to_str().unwrap()], &case[..], &["--format", format]].concat(), &scratch());
     let Run { code, out, err } = run("csv");
@@ -294,7 +293,7 @@ fn odd_sensor_names_keep_every_output_valid() {
     let Run { out, .. } = run("json");
     assert!(out.contains(r#""name": "desk, \"north\"""#) && out.contains(r#""name": "two\nlines""#), "{out}");
     assert!(out.contains(r#""name": "bell\u0007""#) && !out.contains('\u{7}'), "{out}");
-    let export = dir.join("export");
+    let export = scene.with_file_name("export");
     let Run { code, err, .. } =
         heliodon(&[&["export-radiance", scene.to_str().unwrap()], &case[..], &["--out", export.to_str().unwrap()]].concat(), &scratch());
     assert_eq!(code, 0, "{err}");
@@ -480,10 +479,6 @@ fn annual_refuses_bad_weather_and_scenes_without_sensors_in_one_line() {
     assert!(err.contains("--occupied") && err.contains("the end is not after the start"), "{err}");
 
     // Shade groups: checked where they are read; the study refuses them until they are modelled.
-    for file in ["model.obj", "model.mtl"] {
-        std::fs::copy(room.with_file_name(file), dir.join(file)).unwrap();
-    }
-    let base = std::fs::read_to_string(&room).unwrap();
     let blinds = "\n[materials.blinds]\nkind = \"glass\"\ntransmittance = 0.1\n";
     let cases = [
         ("[[shades]]\nwindows = \"glass\"\nshade = \"blinds\"\n", "operable shades are not modelled yet"),
@@ -491,15 +486,13 @@ fn annual_refuses_bad_weather_and_scenes_without_sensors_in_one_line() {
         ("[[shades]]\nwindows = \"glass\"\nshade = \"curtain\"\n", "shades[0].shade: 'curtain' is not a material of [materials]"),
     ];
     for (shades, expected) in cases {
-        std::fs::write(dir.join("scene.toml"), format!("{base}{blinds}\n{shades}")).unwrap();
-        let scene = dir.join("scene.toml");
+        let scene = test_room_with("annual_shades", &format!("{blinds}\n{shades}"));
         let Run { code, err, .. } = heliodon(&["annual", scene.to_str().unwrap(), "--weather", full.to_str().unwrap()], &scratch());
         assert_eq!(code, 1, "{err}");
         assert!(err.lines().filter(|l| l.starts_with("error")).count() == 1 && err.contains(expected), "{shades}: {err}");
         assert!(!err.contains("no face"), "the shade material is not unused: {err}");
     }
-    std::fs::write(dir.join("scene.toml"), format!("{base}{blinds}\n{}", cases[0].0)).unwrap();
-    let scene = dir.join("scene.toml");
+    let scene = test_room_with("annual_shades", &format!("{blinds}\n{}", cases[0].0));
     let args = ["annual", scene.to_str().unwrap(), "--weather", full.to_str().unwrap(), "--no-shades", "--format", "json"];
     let Run { code, out, err } = heliodon(&args, &scratch());
     assert_eq!(code, 0, "{err}");

@@ -180,9 +180,13 @@ pub fn hour_time(month: u32, day: u32, hour: u32) -> LocalDateTime {
 /// dark (sun below the horizon, no diffuse light); an error when the hour is
 /// lit but its sky cannot be made.
 pub fn hour_sky(site: &Site, when: &LocalDateTime, direct_normal: f64, diffuse_horizontal: f64) -> Result<Option<Sky>, SkyError> {
+    // Most dark hours (nights) have no diffuse light: no sun position or sky is needed for them.
+    if diffuse_horizontal <= 0.0 {
+        return Ok(None);
+    }
     let spec = SkySpec::Perez(perez::Input::Irradiance { direct_normal, diffuse_horizontal });
     let (sun, sky) = sky_at(site, &spec, when);
-    if sun.altitude <= 0.0 || diffuse_horizontal <= 0.0 {
+    if sun.altitude <= 0.0 {
         return Ok(None);
     }
     sky.map(Some)

@@ -90,10 +90,11 @@ pub struct Material {
 const UNASSIGNED_REFLECTANCE: f32 = 0.5;
 
 /// Materials in order, and each tobj material index's place among them.
-pub type ResolvedMaterials = (Vec<Material>, BTreeMap<Option<usize>, u32>);
+pub type ResolvedMaterials = (Vec<Material>, BTreeMap<Option<usize>, u32>, BTreeMap<String, Material>);
 
 /// The materials the model's faces use, in order of tobj's index (faces with
-/// no material last), and each tobj index's place in that list.
+/// no material last), and each tobj index's place in that list; and the
+/// `[materials]` no face uses, by name (shades draw them).
 pub fn resolve(
     parsed: &ParsedScene,
     model: &ObjModel,
@@ -147,7 +148,8 @@ pub fn resolve(
         index.insert(id, materials.len() as u32);
         materials.push(material);
     }
-    Ok((materials, index))
+    let unused = scene_materials.into_iter().map(|(name, material)| (name.to_string(), material)).collect();
+    Ok((materials, index, unused))
 }
 
 pub(super) fn scene_material(

@@ -254,8 +254,8 @@ fn build(
 ) -> Result<LoadedScene, SceneError> {
     let mut warnings = Vec::new();
     let model = obj::import(&obj_path, obj_text, &obj_scan, &mtls)?;
-    let (materials, material_of) = material::resolve(&parsed, &model, panels, &obj_path, &mut warnings)?;
-    let shades = shades::shade_groups(&parsed, &materials, panels)?;
+    let (materials, material_of, unused_materials) = material::resolve(&parsed, &model, panels, &obj_path, &mut warnings)?;
+    let shades = shades::shade_groups(&parsed, &materials, &unused_materials)?;
     // A model in survey coordinates is recentred, in f64, before anything
     // becomes f32 (which keeps millimetres only within a few km of 0).
     if let Some(centre) = obj::far_centre(&model, RECENTRE_BEYOND) {

@@ -2,10 +2,11 @@
 //! windows (every window of one material) and the material drawn in them
 //! when the shade is down.
 
+use std::collections::BTreeMap;
+
 use super::error::SceneError;
 use super::file::ParsedScene;
-use super::material::{Material, MaterialKind, scene_material};
-use crate::panel::PanelCatalog;
+use super::material::{Material, MaterialKind};
 
 /// One shade group.
 #[derive(Debug, Clone, PartialEq)]
@@ -17,8 +18,14 @@ pub struct ShadeGroup {
 }
 
 /// The scene file's shade groups: `windows` names a glass or panel material
-/// the model's faces use, `shade` a glass or panel material of `[materials]`.
-pub fn shade_groups(parsed: &ParsedScene, materials: &[Material], panels: &PanelCatalog) -> Result<Vec<ShadeGroup>, SceneError> {
+/// the model's faces use, `shade` a glass or panel material of `[materials]`
+/// (as the loader built it: in `materials` when faces use it too, else in
+/// `unused`).
+pub fn shade_groups(
+    parsed: &ParsedScene,
+    materials: &[Material],
+    unused: &BTreeMap<String, Material>,
+) -> Result<Vec<ShadeGroup>, SceneError> {
     let transmits = |kind: &MaterialKind| matches!(kind, MaterialKind::Glass { .. } | MaterialKind::Panel { .. });
     parsed
         .shades
@@ -38,14 +45,15 @@ pub fn shade_groups(parsed: &ParsedScene, materials: &[Material], panels: &Panel
                     format!("'{}' is not a window material (glass or panel)", windows.get_ref()),
                 );
             }
-            let Some(table) = parsed.materials.get(shade.get_ref()) else {
-                return parsed.error(shade.span(), key("shade"), format!("'{}' is not a material of [materials]", shade.get_ref()));
+            let name = shade.get_ref();
+            let built = unused.get(name).or_else(|| materials.iter().find(|m| &m.name == name));
+            let Some(material) = built.filter(|_| parsed.materials.contains_key(name)) else {
+                return parsed.error(shade.span(), key("shade"), format!("'{name}' is not a material of [materials]"));
             };
-            let material = scene_material(parsed, shade.get_ref(), table, panels)?;
             if !transmits(&material.kind) {
                 return parsed.error(shade.span(), key("shade"), format!("'{}' is not glass or a panel", shade.get_ref()));
             }
-            Ok(ShadeGroup { windows: index as u32, shade: material })
+            Ok(ShadeGroup { windows: index as u32, shade: material.clone() })
         })
         .collect()
 }
