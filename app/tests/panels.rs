@@ -159,6 +159,31 @@ fn sunlight_through_a_prismatic_window_is_conserved() {
     assert!((landed / expected - 1.0).abs() < 0.03, "landed {landed} vs {expected}");
 }
 
+/// The annual path's sensor coefficients read panel rooms as a radiosity
+/// solve does: the sky through each panel group's transfer, its diffused
+/// sun and its lobes (past an overhang) all folded in.
+#[test]
+fn sensor_coefficients_read_panel_rooms_as_a_solve_does() {
+    use std::sync::Arc;
+    for (name, body) in [
+        ("coefficients_prismatic", "panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n"),
+        ("coefficients_grey", "panel = \"grey_filter\"\ntransmittance = 0.4\n"),
+    ] {
+        let path = room_with(name, Some(body), true);
+        let scene = Arc::new(load_scene(&path, &all_panels()).unwrap().scene);
+        let model = heliodon::light::LightModel::precompute(scene.clone(), quick()).unwrap();
+        let sky = winter_noon(&scene);
+        let solved = model.solve(&sky, None);
+        let read = model.sensor_coefficients().readings(&sky, None);
+        for (a, b) in solved.sensors.iter().zip(&read) {
+            let close = |x: f64, y: f64, tolerance: f64| (x - y).abs() <= tolerance * x.abs().max(y.abs()) + 0.01;
+            assert!(close(a.direct_sun, b.direct_sun, 1e-9) && close(a.direct_sky, b.direct_sky, 1e-9), "{name}: {a:?} vs {b:?}");
+            assert!(close(a.indirect, b.indirect, 2e-3), "{name} indirect: {a:?} vs {b:?}");
+        }
+        assert!(read.iter().any(|r| r.direct_sun > 100.0 && r.indirect > 10.0), "{name}: sun comes in: {read:?}");
+    }
+}
+
 /// The renderer draws each panel lobe as a fake sun: the direct-sun image
 /// of each panel room agrees with the CPU reference (shadow rays along the
 /// lobes through the panel), pixel by pixel.

@@ -3,27 +3,28 @@
 //! sensor, and the scene's sDA300/50% and ASE1000/250 (IES LM-83), as the
 //! contract's "Annual climate-based daylight" defines them.
 //!
-//! How it works, for now:
+//! How it works:
 //! 1. Each EPW hour (ending at `h`) is evaluated at `h − 0.5` local standard
 //!    time, under the Perez all-weather sky of its direct normal and diffuse
 //!    horizontal irradiance: the same sky `sensors --sky perez --dni --dhi`
 //!    makes, so the two agree hour by hour.
 //! 2. Hours with the sun below the horizon, no diffuse light or no sky that
 //!    can be made read 0 lux.
-//! 3. Every lit hour is one relight of the precomputed model (direct sky
-//!    from daylight coefficients, exact sun rays and panel lobes, the
-//!    radiosity warm-started from the hour before). Runs of whole days go
-//!    in parallel, each day's hours in order from a cold start, so the
-//!    numbers do not depend on the thread count; occupied hours are counted
-//!    as they come (memory follows sensors, not hours, unless every hour is
-//!    kept for `--hourly`).
+//! 3. Before the first hour, every sensor's radiosity adjoint is solved once
+//!    and folded into coefficients ([`crate::light::coefficients`]): per
+//!    sky bin (and panel group) and per patch side's sun beams. A lit hour
+//!    is then one product of the coefficients with the hour's bin radiances,
+//!    the sun traced exactly (shadow rays through glass and along panel
+//!    lobes, on the sides a sensor sees and where the sensors' rays land),
+//!    and no radiosity solve. Runs of whole days go in parallel; hours are
+//!    independent, so the numbers do not depend on the thread count;
+//!    occupied hours are counted as they come (memory follows sensors, not
+//!    hours, unless every hour is kept for `--hourly`).
 //! 4. ASE counts the direct sun alone (no sky, no interreflection).
 //!
-//! This is the plain path: one radiosity solve per lit hour (about 4,400 a
-//! year). Indirect daylight coefficients per sky bin, which would make the
-//! year a few matrix products, and LM-83 operable shades are not built yet.
+//! LM-83 operable shades are not modelled yet.
 
-use crate::light::{LightModel, Lighting, par_map};
+use crate::light::{LightModel, par_map};
 use crate::site::Site;
 use crate::sky::{Sky, SkyError, SkySpec, perez, sky_at};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
@@ -209,23 +210,19 @@ pub fn annual(
     // hours (unless every hour is kept). Each day starts cold, so the split
     // does not change a number.
     let runs = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let coefficients = model.sensor_coefficients();
     let year: Vec<(Tally, Vec<Vec<f32>>)> = par_map(None, runs, |run| {
         let mut tally = Tally::new(sensor_count);
         let mut hourly = Vec::new();
         for day in run * days / runs..(run + 1) * days / runs {
-            let mut previous: Option<Lighting> = None;
             for hour in &weather.hours[day * 24..day * 24 + 24] {
                 let when = hour_time(hour.month, hour.day, hour.hour);
                 let sky = hour_sky(site, &when, hour.direct_normal, hour.diffuse_horizontal).unwrap_or_else(|_| {
                     tally.skipped += 1;
                     None
                 });
-                let readings: Option<Vec<(f64, f64)>> = sky.map(|sky| {
-                    let lighting = model.solve(&sky, previous.as_ref());
-                    let readings = lighting.sensors.iter().map(|r| (r.total, r.direct_sun)).collect();
-                    previous = Some(lighting);
-                    readings
-                });
+                let readings: Option<Vec<(f64, f64)>> =
+                    sky.map(|sky| coefficients.readings(&sky, Some(1)).iter().map(|r| (r.total, r.direct_sun)).collect());
                 if occupancy.contains(hour.hour) {
                     tally.count(readings.as_deref());
                 }

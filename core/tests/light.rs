@@ -505,3 +505,36 @@ fn survey_coordinates_are_recentred_for_precision() {
         assert!((f - n).abs() < 0.01 * n, "{f} vs {n}");
     }
 }
+
+/// The annual path's coefficients (the radiosity's adjoint per sensor)
+/// read what a radiosity solve of the same sky reads: direct light
+/// exactly, interreflected light to the solver's tolerance; on any number
+/// of threads the same numbers.
+#[test]
+fn sensor_coefficients_read_what_a_radiosity_solve_reads() {
+    let scene = load(&heliodon_core::bundled_scene("office"));
+    let model = LightModel::precompute(scene.clone(), quick()).unwrap();
+    let coefficients = model.sensor_coefficients();
+    let perez =
+        |dni: f64, dhi: f64| SkySpec::Perez(heliodon_core::sky::perez::Input::Irradiance { direct_normal: dni, diffuse_horizontal: dhi });
+    let skies = [
+        (perez(750.0, 110.0), "2026-06-21", "16:30"),
+        (perez(420.0, 180.0), "2026-03-10", "09:30"),
+        (perez(0.0, 160.0), "2026-11-02", "12:30"),
+        (perez(820.0, 60.0), "2026-12-21", "14:30"),
+        (SkySpec::Overcast, "2026-03-21", "10:00"),
+    ];
+    for (spec, date, time) in &skies {
+        let sky = sky_at(&scene, spec, date, time);
+        let solved = model.solve(&sky, None);
+        let read = coefficients.readings(&sky, None);
+        for (a, b) in solved.sensors.iter().zip(&read) {
+            let close = |x: f64, y: f64, tolerance: f64| (x - y).abs() <= tolerance * x.abs().max(y.abs()) + 0.01;
+            assert!(close(a.direct_sun, b.direct_sun, 1e-9) && close(a.direct_sky, b.direct_sky, 1e-9), "{date} {time}: {a:?} vs {b:?}");
+            assert!(close(a.indirect, b.indirect, 2e-3), "{date} {time} indirect: {a:?} vs {b:?}");
+        }
+        assert!(read.iter().any(|r| r.indirect > 10.0), "{date} {time}: a lit office");
+    }
+    let sky = sky_at(&scene, &skies[0].0, skies[0].1, skies[0].2);
+    assert_eq!(coefficients.readings(&sky, Some(1)), coefficients.readings(&sky, Some(3)));
+}

@@ -416,7 +416,7 @@ impl SensorGeometry {
         let gather = r.gather()?;
         let n = count(r, 20)?;
         let hits = (0..n).map(|_| Some((r.u32()?, r.f32()?, [r.f32()?, r.f32()?, r.f32()?]))).collect::<Option<Vec<_>>>()?;
-        Some(Self { sun_points, normal, gather, hits })
+        Some(Self::new(gather, sun_points, normal, hits))
     }
 }
 

@@ -7,7 +7,7 @@
 use std::f64::consts::PI;
 
 use super::LightModel;
-use super::gather::SkyKey;
+use super::gather::{Gather, SkyKey};
 use crate::sky::{LUMINOUS_EFFICACY, Sky};
 
 /// Radiance behind gather keys ([`SkyKey`]) for one sky.
@@ -38,6 +38,52 @@ impl KeyRadiance {
         let key = SkyKey::unpack(key, self.bin_count);
         key.window.and_then(|w| self.window_panel[w as usize]).map_or(0.0, |group| self.panel_sun[group as usize])
     }
+
+    /// Sky and ground irradiance (W/m²) of a receiver with `gather`.
+    pub(super) fn sky_irradiance(&self, gather: &Gather) -> f64 {
+        PI * gather.daylight_coefficients.iter().map(|&(k, w)| f64::from(w) * self.of(k)).sum::<f64>()
+    }
+
+    /// Sunlight that panels transmit diffusely (W/m²), seen through them.
+    pub(super) fn panel_sun_irradiance(&self, gather: &Gather) -> f64 {
+        PI * gather.daylight_coefficients.iter().map(|&(k, w)| f64::from(w) * self.sun_of(k)).sum::<f64>()
+    }
+
+    /// Every distinct radiance a key can carry, in [`RadianceSlots`] order.
+    pub(super) fn slots(&self) -> Vec<f64> {
+        let mut slots = self.bins.clone();
+        self.panels.iter().for_each(|group| slots.extend(group));
+        slots.extend(&self.panel_sun);
+        slots
+    }
+}
+
+/// The distinct radiances behind gather keys, numbered: sphere bins seen
+/// straight or through glass, then the bins through each panel group, then
+/// each group's diffusely transmitted sun.
+#[derive(Debug, Clone)]
+pub(super) struct RadianceSlots {
+    bin_count: u32,
+    groups: usize,
+    /// Per scene window: its panel group.
+    window_panel: Vec<Option<u32>>,
+}
+
+impl RadianceSlots {
+    pub(super) fn len(&self) -> usize {
+        self.bin_count as usize * (1 + self.groups) + self.groups
+    }
+
+    /// The slot of a key's sky radiance, and of its diffuse panel sun if it
+    /// looks through a panel.
+    pub(super) fn of(&self, key: u32) -> (usize, Option<usize>) {
+        let key = SkyKey::unpack(key, self.bin_count);
+        let bins = self.bin_count as usize;
+        match key.window.and_then(|w| self.window_panel[w as usize]) {
+            Some(g) => (bins * (1 + g as usize) + key.bin as usize, Some(bins * (1 + self.groups) + g as usize)),
+            None => (key.bin as usize, None),
+        }
+    }
 }
 
 impl LightModel {
@@ -63,6 +109,15 @@ impl LightModel {
             .collect()
     }
 
+    /// How [`KeyRadiance::slots`] are numbered for this model.
+    pub(super) fn radiance_slots(&self) -> RadianceSlots {
+        RadianceSlots { bin_count: self.bin_count(), groups: self.panel_groups.len(), window_panel: self.window_panels() }
+    }
+
+    fn window_panels(&self) -> Vec<Option<u32>> {
+        self.scene.windows.iter().map(|w| self.group_of_surface[w.surface as usize]).collect()
+    }
+
     /// The radiance behind each gather key under `sky`: a bin's own, or
     /// through a panel window what the panel makes of the sky and sun.
     pub(super) fn key_radiance(&self, sky: &Sky) -> KeyRadiance {
@@ -71,7 +126,6 @@ impl LightModel {
         let sun = sky.sun.filter(|s| s.direction.z > 0.0);
         let panels = self.panel_groups.iter().map(|g| g.radiance_through(&self.sky_bins, &bins)).collect();
         let panel_sun = self.panel_groups.iter().map(|g| g.sun_diffuse_radiance(sun.as_ref())).collect();
-        let window_panel = self.scene.windows.iter().map(|w| self.group_of_surface[w.surface as usize]).collect();
-        KeyRadiance { bin_count: self.bin_count(), bins, panels, panel_sun, window_panel }
+        KeyRadiance { bin_count: self.bin_count(), bins, panels, panel_sun, window_panel: self.window_panels() }
     }
 }

@@ -118,10 +118,27 @@ pub(super) struct SensorGeometry {
     pub(super) sun_points: Vec<DVec3>,
     pub(super) normal: DVec3,
     pub(super) gather: Gather,
-    /// Where the sensor's rays meet patches, with their shares: the sun's
-    /// first bounce is evaluated at these points, not averaged over patches
-    /// (a sun patch right beside a sensor is what patch averages get wrong).
+    /// Where the sensor's rays meet patch sides, with their shares, sorted
+    /// by side: the sun's first bounce is evaluated at these points, not
+    /// averaged over patches (a sun patch right beside a sensor is what
+    /// patch averages get wrong).
     pub(super) hits: Vec<(u32, f32, [f32; 3])>,
+    /// Where each side's run of `hits` ends.
+    run_ends: Vec<u32>,
+}
+
+impl SensorGeometry {
+    pub(super) fn new(gather: Gather, sun_points: Vec<DVec3>, normal: DVec3, mut hits: Vec<(u32, f32, [f32; 3])>) -> Self {
+        hits.sort_by_key(|h| h.0);
+        let run_ends = (1..=hits.len()).filter(|&k| k == hits.len() || hits[k].0 != hits[k - 1].0).map(|k| k as u32).collect();
+        Self { sun_points, normal, gather, hits, run_ends }
+    }
+
+    /// The hits, a run per side.
+    pub(super) fn hits_by_side(&self) -> impl Iterator<Item = &[(u32, f32, [f32; 3])]> {
+        let starts = std::iter::once(0).chain(self.run_ends.iter().copied());
+        starts.zip(&self.run_ends).map(|(start, &end)| &self.hits[start as usize..end as usize])
+    }
 }
 
 impl LightModel {
@@ -253,7 +270,7 @@ impl LightModel {
         let rays = per_point * points.len();
         let gather = Gather::from_raw(coefficients, &hits, rays);
         let hits = hits.iter().map(|h| (h.side, (h.weight / rays as f64) as f32, h.point.as_vec3().to_array())).collect();
-        SensorGeometry { gather, sun_points, normal, hits }
+        SensorGeometry::new(gather, sun_points, normal, hits)
     }
 }
 

@@ -14,19 +14,26 @@
 //!    by shadow rays through windows and along panel lobes ([`sun`],
 //!    [`panels`]), direct sky as the sparse product of daylight coefficients
 //!    and bin radiances ([`daylight`]).
+//!    Shadow rays are spared where the sun cannot come in ([`openings`]).
 //! 3. **Interreflection** ([`solver`]): Jacobi iterations over the form
 //!    factors, RGB, warm-started from a previous solution
 //!    ([`Relight::step`]); sensors gather through their own rays, never
 //!    from the nearest patch.
+//! 4. **Many skies** ([`coefficients`], the annual study): each sensor's
+//!    adjoint of step 3, solved once, folds the interreflection into
+//!    coefficients per sky bin and per side's sun; a sky is then a product,
+//!    not a solve.
 //!
 //! Results are deterministic: every receiver has its own seeded generator
 //! ([`sampling`]). Knobs: [`LightSettings`]. Plain Rust, no Bevy types.
 
 mod bvh;
 pub mod cache;
+pub mod coefficients;
 pub mod daylight;
 pub mod gather;
 mod glass;
+mod openings;
 pub mod panels;
 mod sampling;
 pub mod settings;
@@ -38,6 +45,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
+pub use coefficients::SensorCoefficients;
 pub use gather::{Gather, SkyKey, sensor_points, side_of};
 pub use glass::Glass;
 pub use panels::{PanelFrame, SunBeam};
@@ -86,6 +94,8 @@ pub struct LightModel {
     /// Panel windows by material and orientation, and each surface's group.
     panel_groups: Vec<panels::PanelGroup>,
     group_of_surface: Vec<Option<u32>>,
+    /// Where the sun can come in (spares shadow rays).
+    openings: openings::Openings,
     /// Per patch side (2 per patch; empty for glass and panels).
     side_gathers: Vec<Gather>,
     sensors: Vec<SensorGeometry>,
@@ -109,9 +119,16 @@ pub struct Channels {
 impl Channels {
     /// Photometric indirect irradiance (Radiance's RGB weights).
     pub fn indirect_luminous(&self) -> f64 {
-        let [r, g, b] = self.indirect;
-        0.265 * r + 0.670 * g + 0.065 * b
+        luminous(self.indirect)
     }
+}
+
+/// Radiance's weights of red, green and blue in luminous quantities.
+pub const RGB_TO_LUMINOUS: [f64; 3] = [0.265, 0.670, 0.065];
+
+/// The luminous part of an RGB quantity (Radiance's weights).
+pub fn luminous(rgb: [f64; 3]) -> f64 {
+    rgb.iter().zip(RGB_TO_LUMINOUS).map(|(c, w)| c * w).sum()
 }
 
 /// A sensor's reading in lux.
@@ -187,6 +204,7 @@ impl LightModel {
             .collect();
         let windows = WindowGroups::new(&scene, &tracer);
         let (panel_groups, group_of_surface) = panels::panel_groups(&scene, &windows);
+        let openings = openings::Openings::new(&scene, &group_of_surface);
         let mut window_of_surface = vec![None; scene.surfaces.len()];
         for (k, window) in scene.windows.iter().enumerate() {
             window_of_surface[window.surface as usize] = Some(k as u32);
@@ -197,6 +215,7 @@ impl LightModel {
             window_of_surface,
             panel_groups,
             group_of_surface,
+            openings,
             scene,
             settings,
             tracer,
@@ -216,6 +235,17 @@ impl LightModel {
 
     fn patch_normal(&self, patch: u32) -> DVec3 {
         self.scene.patches.patches[patch as usize].normal.as_dvec3()
+    }
+
+    /// The outward normal of a patch side ([`side_of`]).
+    fn side_normal(&self, side: u32) -> DVec3 {
+        self.patch_normal(side / 2) * if side % 2 == 1 { -1.0 } else { 1.0 }
+    }
+
+    /// Whether some gather ray of the side left straight to the open sky or
+    /// ground, through no window (keys are sorted, windowless ones first).
+    fn side_is_open(&self, side: usize) -> bool {
+        self.side_gathers[side].daylight_coefficients.first().is_some_and(|&(k, _)| SkyKey::unpack(k, self.bin_count()).window.is_none())
     }
 
     /// Bins of the sky sphere (sky above the horizon, ground below).

@@ -12,10 +12,6 @@
 //! Every product of form factors and exitance, for patch sides and for
 //! sensors alike, is [`form_factor_product`].
 
-use std::f64::consts::PI;
-
-use super::gather::{Gather, sample_area};
-use super::sampling::Rng;
 use super::{Channels, LightModel, Lighting, SensorReading, Surface, par_map};
 use crate::sky::{LUMINOUS_EFFICACY, Sky};
 
@@ -137,27 +133,20 @@ impl LightModel {
         let patches = &self.scene.patches.patches;
         let sun = sky.sun.filter(|s| s.direction.z > 0.0);
         let seen = self.key_radiance(sky);
-        let sky_irradiance = |g: &Gather| PI * g.daylight_coefficients.iter().map(|&(k, w)| f64::from(w) * seen.of(k)).sum::<f64>();
-        // Sunlight that panels transmit diffusely, seen through them.
-        let panel_sun = |g: &Gather| PI * g.daylight_coefficients.iter().map(|&(k, w)| f64::from(w) * seen.sun_of(k)).sum::<f64>();
         let beams = sun.map(|s| self.sun_beams(&s)).unwrap_or_default();
+        let sides_sun = self.sun_on_sides(&beams, None, self.settings.threads);
         let direct: Vec<Channels> = par_map(self.settings.threads, patches.len() * 2, |side| {
             let gather = &self.side_gathers[side];
-            let patch = &patches[side / 2];
-            if !matches!(self.surfaces[patch.material as usize], Surface::Diffuse(_)) {
+            if !matches!(self.surfaces[patches[side / 2].material as usize], Surface::Diffuse(_)) {
                 return Channels::default();
             }
-            let normal = patch.normal.as_dvec3() * if side % 2 == 1 { -1.0 } else { 1.0 };
-            let diffuse_sun = panel_sun(gather);
-            let mut channels = Channels { sky: sky_irradiance(gather), sun: diffuse_sun, sun_diffuse: diffuse_sun, ..Default::default() };
-            if beams.iter().any(|b| normal.dot(b.to_light) > 0.0) {
-                let triangles = self.patch_triangles(side / 2);
-                let mut rng = Rng::new(3, side as u64);
-                let n = self.settings.sun_samples_per_patch;
-                let total: f64 = (0..n).map(|_| self.beams_irradiance(sample_area(&triangles, &mut rng), normal, &beams)).sum();
-                channels.sun += total / n as f64;
+            let diffuse_sun = seen.panel_sun_irradiance(gather);
+            Channels {
+                sky: seen.sky_irradiance(gather),
+                sun: diffuse_sun + sides_sun.irradiance[side],
+                sun_diffuse: diffuse_sun,
+                ..Default::default()
             }
-            channels
         });
         let reflectance: Vec<[f64; 3]> = (0..patches.len() * 2)
             .map(|side| match self.surfaces[patches[side / 2].material as usize] {
@@ -168,22 +157,8 @@ impl LightModel {
         // Each sensor's direct light and the first bounce of sun where its rays land.
         let sensors: Vec<SensorDirect> = par_map(self.settings.threads, self.sensors.len(), |i| {
             let geometry = &self.sensors[i];
-            let mut out = SensorDirect { sky: sky_irradiance(&geometry.gather), sun: panel_sun(&geometry.gather), ..Default::default() };
-            if beams.is_empty() {
-                return out;
-            }
-            let total: f64 = geometry.sun_points.iter().map(|&p| self.beams_irradiance(p, geometry.normal, &beams)).sum();
-            out.sun += total / geometry.sun_points.len() as f64;
-            for &(j, w, point) in &geometry.hits {
-                let side_normal = self.patch_normal(j / 2) * if j % 2 == 1 { -1.0 } else { 1.0 };
-                if beams.iter().any(|b| side_normal.dot(b.to_light) > 0.0) {
-                    let e = self.beams_irradiance(glam::Vec3::from_array(point).as_dvec3(), side_normal, &beams);
-                    for (bounce, rho) in out.sun_bounce.iter_mut().zip(reflectance[j as usize]) {
-                        *bounce += f64::from(w) * rho * e;
-                    }
-                }
-            }
-            out
+            let (sun, sun_bounce) = self.sensor_sun(i, &beams, &sides_sun.reach);
+            SensorDirect { sky: seen.sky_irradiance(&geometry.gather), sun: seen.panel_sun_irradiance(&geometry.gather) + sun, sun_bounce }
         });
         let warm = warm.filter(|w| w.sides.len() == direct.len()).map(|w| {
             // Scaled by how much the direct light changed: close when the

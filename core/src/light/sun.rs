@@ -6,9 +6,41 @@
 
 use glam::DVec3;
 
+use super::gather::sample_area;
+use super::openings::{Openings, WayIn};
 use super::panels::{self, SunBeam};
-use super::{LightModel, MAX_GLASS_DEPTH, SURFACE_OFFSET, Surface};
+use super::sampling::Rng;
+use super::{LightModel, MAX_GLASS_DEPTH, SURFACE_OFFSET, Surface, par_map};
 use crate::sky::SunSource;
+
+/// The sun's beams on every patch side, and where they may land.
+pub(super) struct SidesSun {
+    /// Beam irradiance (W/m²) of each side, averaged over its sun samples.
+    pub(super) irradiance: Vec<f64>,
+    /// How beams may reach each side ([`super::openings`]).
+    pub(super) reach: Vec<Reach>,
+}
+
+/// How the beams may reach a patch side.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum Reach {
+    /// Not at all: facing away, or enclosed with no window toward a beam.
+    None,
+    /// From anywhere: the side sees the open sky.
+    Open,
+    /// Only by these windows.
+    Through(Vec<WayIn>),
+}
+
+impl Reach {
+    fn may_reach(&self, openings: &Openings, point: DVec3, beams: &[SunBeam]) -> bool {
+        match self {
+            Reach::None => false,
+            Reach::Open => true,
+            Reach::Through(ways) => openings.point_may_be_reached(point, ways, beams),
+        }
+    }
+}
 
 impl LightModel {
     /// Direct sun irradiance (W/m²) at `point` on a surface side with
@@ -26,7 +58,9 @@ impl LightModel {
         let mut transmittance = 1.0;
         // Glass surfaces crossed, by distance: a ray through the edge between
         // two triangles of one surface meets it twice.
-        let mut crossed: Vec<(u32, f64)> = Vec::new();
+        // (A few at most: kept on the stack, shadow rays are many.)
+        let mut crossed = [(u32::MAX, 0.0); 16];
+        let mut count = 0;
         self.tracer.each_hit(point, sun, 1e-6, |hit| {
             let patch = &self.scene.patches.patches[hit.patch as usize];
             match self.surface_of_patch(hit.patch) {
@@ -36,8 +70,9 @@ impl LightModel {
                     false
                 }
                 Surface::Glass(glass) => {
-                    if !crossed.iter().any(|&(s, d)| s == patch.surface && (d - hit.distance).abs() < 1e-5) {
-                        crossed.push((patch.surface, hit.distance));
+                    if !crossed[..count].iter().any(|&(s, d)| s == patch.surface && (d - hit.distance).abs() < 1e-5) {
+                        crossed[count.min(15)] = (patch.surface, hit.distance);
+                        count = (count + 1).min(16);
                         transmittance *= glass.at(sun.dot(patch.normal.as_dvec3())).0;
                     }
                     true
@@ -71,6 +106,77 @@ impl LightModel {
             return Vec::new();
         }
         panels::sun_beams(&self.panel_groups, sun)
+    }
+
+    /// The beams on every diffuse patch side: shadow rays from
+    /// `sun_samples_per_patch` seeded points of each side that faces a beam
+    /// and that a beam may reach; only the sides `wanted` when given
+    /// (`threads` as [`par_map`]).
+    pub(super) fn sun_on_sides(&self, beams: &[SunBeam], wanted: Option<&[bool]>, threads: Option<usize>) -> SidesSun {
+        let patches = &self.scene.patches.patches;
+        let sides: Vec<(f64, Reach)> = par_map(threads, patches.len() * 2, |side| {
+            let patch = &patches[side / 2];
+            if beams.is_empty()
+                || wanted.is_some_and(|w| !w[side])
+                || !matches!(self.surfaces[patch.material as usize], Surface::Diffuse(_))
+            {
+                return (0.0, Reach::None);
+            }
+            let normal = self.side_normal(side as u32);
+            let reach = match () {
+                _ if !beams.iter().any(|b| normal.dot(b.to_light) > 0.0) => Reach::None,
+                _ if self.side_is_open(side) => Reach::Open,
+                _ => match self.openings.ways_in(side / 2, beams) {
+                    ways if ways.is_empty() => Reach::None,
+                    ways => Reach::Through(ways),
+                },
+            };
+            if reach == Reach::None {
+                return (0.0, reach);
+            }
+            let triangles = self.patch_triangles(side / 2);
+            let mut rng = Rng::new(3, side as u64);
+            let n = self.settings.sun_samples_per_patch;
+            let total: f64 = (0..n)
+                .map(|_| sample_area(&triangles, &mut rng))
+                .filter(|&point| reach.may_reach(&self.openings, point, beams))
+                .map(|point| self.beams_irradiance(point, normal, beams))
+                .sum();
+            (total / n as f64, reach)
+        });
+        let (irradiance, reach) = sides.into_iter().unzip();
+        SidesSun { irradiance, reach }
+    }
+
+    /// Sensor `index`'s direct sun (W/m², averaged over its sun points) and
+    /// the first bounce of the beams off the sides its rays meet (RGB W/m²,
+    /// evaluated where each ray lands), given how beams `reach` each side.
+    pub(super) fn sensor_sun(&self, index: usize, beams: &[SunBeam], reach: &[Reach]) -> (f64, [f64; 3]) {
+        let geometry = &self.sensors[index];
+        if beams.is_empty() {
+            return (0.0, [0.0; 3]);
+        }
+        let direct: f64 = geometry.sun_points.iter().map(|&p| self.beams_irradiance(p, geometry.normal, beams)).sum();
+        let mut bounce = [0.0; 3];
+        for run in geometry.hits_by_side() {
+            let side = run[0].0;
+            let reach = &reach[side as usize];
+            if *reach == Reach::None {
+                continue;
+            }
+            let Surface::Diffuse(rho) = self.surfaces[self.scene.patches.patches[side as usize / 2].material as usize] else { continue };
+            let normal = self.side_normal(side);
+            for &(_, share, point) in run {
+                let point = glam::Vec3::from_array(point).as_dvec3();
+                if reach.may_reach(&self.openings, point, beams) {
+                    let e = self.beams_irradiance(point, normal, beams);
+                    for (b, r) in bounce.iter_mut().zip(rho) {
+                        *b += f64::from(share) * r * e;
+                    }
+                }
+            }
+        }
+        (direct / geometry.sun_points.len() as f64, bounce)
     }
 
     /// Direct sun irradiance (W/m²) from all `beams` at `point` on a surface
