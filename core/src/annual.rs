@@ -12,19 +12,21 @@
 //!    can be made read 0 lux.
 //! 3. Before the first hour, every sensor's radiosity adjoint is solved once
 //!    and folded into coefficients ([`crate::light::coefficients`]): per
-//!    sky bin (and panel group) and per patch side's sun beams. A lit hour
-//!    is then one product of the coefficients with the hour's bin radiances,
-//!    the sun traced exactly (shadow rays through glass and along panel
-//!    lobes, on the sides a sensor sees and where the sensors' rays land),
-//!    and no radiosity solve. Runs of whole days go in parallel; hours are
-//!    independent, so the numbers do not depend on the thread count;
+//!    sky bin (and panel group) and per patch side's sun beams; and the
+//!    sun's later bounces are traced at the nodes of a sun path around the
+//!    year's sun positions. A lit hour is then one product of the
+//!    coefficients with the hour's bin radiances, the direct sun and its
+//!    first bounce traced exactly (shadow rays through glass and along panel
+//!    lobes, where the sensors' rays land), the later bounces read from the
+//!    path, and no radiosity solve. Runs of whole days go in parallel; hours
+//!    are independent, so the numbers do not depend on the thread count;
 //!    occupied hours are counted as they come (memory follows sensors, not
 //!    hours, unless every hour is kept for `--hourly`).
 //! 4. ASE counts the direct sun alone (no sky, no interreflection).
 //!
 //! LM-83 operable shades are not modelled yet.
 
-use crate::light::{LightModel, par_map};
+use crate::light::{LightModel, SunPath, par_map};
 use crate::site::Site;
 use crate::sky::{Sky, SkyError, SkySpec, perez, sky_at};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
@@ -211,18 +213,25 @@ pub fn annual(
     // does not change a number.
     let runs = std::thread::available_parallelism().map_or(1, |n| n.get());
     let coefficients = model.sensor_coefficients();
+    // Every hour's sky first: the sun path is traced around the suns of the lit ones.
+    let skies: Vec<Result<Option<Sky>, SkyError>> = par_map(None, HOURS, |k| {
+        let hour = &weather.hours[k];
+        hour_sky(site, &hour_time(hour.month, hour.day, hour.hour), hour.direct_normal, hour.diffuse_horizontal)
+    });
+    let suns: Vec<_> = skies.iter().flatten().flatten().filter_map(|sky| sky.sun.map(|s| s.direction)).collect();
+    let sun_path = SunPath::new(&coefficients, site, &suns, None);
     let year: Vec<(Tally, Vec<Vec<f32>>)> = par_map(None, runs, |run| {
         let mut tally = Tally::new(sensor_count);
         let mut hourly = Vec::new();
         for day in run * days / runs..(run + 1) * days / runs {
-            for hour in &weather.hours[day * 24..day * 24 + 24] {
-                let when = hour_time(hour.month, hour.day, hour.hour);
-                let sky = hour_sky(site, &when, hour.direct_normal, hour.diffuse_horizontal).unwrap_or_else(|_| {
+            for (hour, sky) in weather.hours[day * 24..day * 24 + 24].iter().zip(&skies[day * 24..day * 24 + 24]) {
+                let sky = sky.as_ref().unwrap_or_else(|_| {
                     tally.skipped += 1;
-                    None
+                    &None
                 });
-                let readings: Option<Vec<(f64, f64)>> =
-                    sky.map(|sky| coefficients.readings(&sky, Some(1)).iter().map(|r| (r.total, r.direct_sun)).collect());
+                let readings: Option<Vec<(f64, f64)>> = sky
+                    .as_ref()
+                    .map(|sky| coefficients.readings_on_path(sky, &sun_path, Some(1)).iter().map(|r| (r.total, r.direct_sun)).collect());
                 if occupancy.contains(hour.hour) {
                     tally.count(readings.as_deref());
                 }

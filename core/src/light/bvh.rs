@@ -21,7 +21,7 @@ fn to_bvh(v: DVec3) -> Vec3A {
 /// The closest surface along a ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hit {
-    /// The patch owning the triangle hit.
+    /// The patch owning the triangle hit (or the owner the tracer was built with).
     pub patch: u32,
     pub distance: f64,
 }
@@ -35,13 +35,18 @@ pub struct Tracer {
 
 impl Tracer {
     pub fn new(mesh: &PatchMesh) -> Self {
-        let triangles: Vec<Triangle> = mesh
-            .triangles
+        Self::over(&mesh.triangles, mesh.triangle_patches())
+    }
+
+    /// A BVH over any triangles, each hit naming `owner[triangle]` as its
+    /// [`Hit::patch`] (a surface, say).
+    pub fn over(triangles: &[[glam::Vec3; 3]], owner: Vec<u32>) -> Self {
+        let triangles: Vec<Triangle> = triangles
             .iter()
             .map(|t| Triangle { v0: to_bvh(t[0].as_dvec3()), v1: to_bvh(t[1].as_dvec3()), v2: to_bvh(t[2].as_dvec3()) })
             .collect();
         let bvh = build_cwbvh_from_tris(&triangles, BvhBuildParams::medium_build(), &mut Duration::default());
-        Self { bvh, triangles, owner: mesh.triangle_patches() }
+        Self { bvh, triangles, owner }
     }
 
     /// The closest hit beyond `t_min` along a unit direction.

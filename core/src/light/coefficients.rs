@@ -20,15 +20,25 @@
 //! sky or ground bin straight or through glass, a bin through a panel
 //! group, a group's diffused sun). A sky then costs one dense product; the
 //! sun is traced as a relight traces it, and only the sides it reaches are
-//! summed. The result equals [`LightModel::solve`] up to the tolerance.
+//! summed. The result equals [`LightModel::solve`] up to the tolerance
+//! ([`SensorCoefficients::readings`]).
+//!
+//! For a year of hours the sun's later bounces (the b-term) come from a
+//! [`SunPath`]: traced once per node of a 2.5° grid of sun positions along
+//! the site's sun path and read between nodes; the direct sun and its first
+//! bounce are still traced every hour ([`SensorCoefficients::readings_on_path`]).
 //!
 //! Cost: Jacobi iterations over the form factors for 3 × sensors right-hand
 //! sides at once (in blocks, so memory stays bounded); the coefficients
 //! hold sensors × slots and sensors × patch sides numbers.
 
+use glam::DVec3;
+
 use super::daylight::RadianceSlots;
-use super::{LightModel, SensorReading, Surface, luminous, par_map};
-use crate::sky::{LUMINOUS_EFFICACY, Sky};
+use super::sun::Reach;
+use super::{LightModel, SensorReading, SunBeam, Surface, luminous, par_map};
+use crate::site::Site;
+use crate::sky::{LUMINOUS_EFFICACY, Sky, SunSource};
 
 /// Sensors whose adjoints are iterated together.
 const BLOCK: usize = 32;
@@ -182,36 +192,196 @@ impl SensorCoefficients<'_> {
     /// Every sensor's reading under `sky` (`threads` as [`par_map`]): equal
     /// to [`LightModel::solve`]'s up to its tolerance.
     pub fn readings(&self, sky: &Sky, threads: Option<usize>) -> Vec<SensorReading> {
+        self.read(sky, threads, |beams| self.interreflected_sun(beams, threads))
+    }
+
+    /// [`Self::readings`] with the sun's light beyond its first bounce read
+    /// from a [`SunPath`] instead of traced; the direct sun and its first
+    /// bounce where the sensors' rays land are still traced.
+    pub fn readings_on_path(&self, sky: &Sky, path: &SunPath, threads: Option<usize>) -> Vec<SensorReading> {
+        self.read(sky, threads, |beams| {
+            let mut lux = self.first_bounce(beams, &self.model.sides_reach(beams, Some(&self.seen), threads), threads);
+            if let Some(sun) = sky.sun.filter(|s| s.direction.z > 0.0) {
+                for (e, later) in lux.iter_mut().zip(path.later_bounces(sun.direction)) {
+                    *e += sun.normal_irradiance() * later;
+                }
+            }
+            lux
+        })
+    }
+
+    /// The readings, with the sun's interreflected light (lux per sensor)
+    /// from `interreflected_sun` of the sky's beams.
+    fn read(&self, sky: &Sky, threads: Option<usize>, interreflected_sun: impl FnOnce(&[SunBeam]) -> Vec<f64>) -> Vec<SensorReading> {
         let model = self.model;
         let count = model.sensors.len();
         let seen = model.key_radiance(sky);
         let beams = sky.sun.filter(|s| s.direction.z > 0.0).map(|s| model.sun_beams(&s)).unwrap_or_default();
-        let sides_sun = model.sun_on_sides(&beams, Some(&self.seen), threads);
-        let mut indirect = vec![0.0f64; count];
+        let mut indirect = interreflected_sun(&beams);
         let slot_radiance = seen.slots();
         debug_assert_eq!(slot_radiance.len(), self.slots.len());
-        let sources = slot_radiance.iter().zip(self.sky.chunks_exact(count.max(1)));
-        let beams_on_sides = sides_sun.irradiance.iter().zip(self.sun.chunks_exact(count.max(1)));
-        for (&radiance, row) in sources.chain(beams_on_sides) {
-            if radiance != 0.0 {
-                for (e, &c) in indirect.iter_mut().zip(row) {
-                    *e += radiance * f64::from(c);
-                }
-            }
-        }
+        add_products(&mut indirect, slot_radiance.iter().zip(self.sky.chunks_exact(count.max(1))));
         par_map(threads, count, |i| {
             let geometry = &model.sensors[i];
-            let (sun, bounce) = model.sensor_sun(i, &beams, &sides_sun.reach);
-            let direct_sun = (seen.panel_sun_irradiance(&geometry.gather) + sun) * LUMINOUS_EFFICACY;
+            let direct_sun = (seen.panel_sun_irradiance(&geometry.gather) + model.sensor_direct_sun(i, &beams)) * LUMINOUS_EFFICACY;
             let direct_sky = seen.sky_irradiance(&geometry.gather) * LUMINOUS_EFFICACY;
-            let indirect = indirect[i] + luminous(bounce) * LUMINOUS_EFFICACY;
             SensorReading {
                 name: model.scene.sensors[i].name.clone(),
-                total: direct_sun + direct_sky + indirect,
+                total: direct_sun + direct_sky + indirect[i],
                 direct_sun,
                 direct_sky,
-                indirect,
+                indirect: indirect[i],
             }
         })
+    }
+
+    /// The beams' interreflected light at every sensor, lux: traced on the
+    /// sides some sensor sees and where the sensors' rays land.
+    fn interreflected_sun(&self, beams: &[SunBeam], threads: Option<usize>) -> Vec<f64> {
+        let sides_sun = self.model.sun_on_sides(beams, Some(&self.seen), threads);
+        let mut lux = self.first_bounce(beams, &sides_sun.reach, threads);
+        add_products(&mut lux, self.later_bounces(&sides_sun.irradiance));
+        lux
+    }
+
+    /// The beams' first bounce where each sensor's rays land, lux.
+    fn first_bounce(&self, beams: &[SunBeam], reach: &[Reach], threads: Option<usize>) -> Vec<f64> {
+        par_map(threads, self.model.sensors.len(), |i| luminous(self.model.sensor_sun_bounce(i, beams, reach)) * LUMINOUS_EFFICACY)
+    }
+
+    /// The terms of the beams' later bounces: each side's beam irradiance
+    /// with its row of coefficients.
+    fn later_bounces<'s>(&'s self, beams_on_sides: &'s [f64]) -> impl Iterator<Item = (&'s f64, &'s [f32])> {
+        beams_on_sides.iter().zip(self.sun.chunks_exact(self.model.sensors.len().max(1)))
+    }
+}
+
+/// `sum` += Σ source × row, over (source, row of coefficients per sensor).
+fn add_products<'r>(sum: &mut [f64], terms: impl Iterator<Item = (&'r f64, &'r [f32])>) {
+    for (&source, row) in terms {
+        if source != 0.0 {
+            for (e, &c) in sum.iter_mut().zip(row) {
+                *e += source * f64::from(c);
+            }
+        }
+    }
+}
+
+/// Sun coefficients: the sun's light beyond its first bounce at every
+/// sensor, per W/m² of direct normal irradiance, traced once per node of a
+/// grid of sun positions (declination × hour angle, so a year's sun path is
+/// a band of it) and read between nodes bilinearly. Radiance's 5-phase
+/// method does this with Reinhart sun positions; here the nodes follow the
+/// sun's own path, and what is sharp is never interpolated: the direct sun
+/// and its first bounce where each sensor's rays land are traced every
+/// hour (a sun patch beside a sensor moves with the hour).
+pub struct SunPath {
+    /// Sine and cosine of the site's latitude.
+    latitude: (f64, f64),
+    /// The site's `north_turn`, radians.
+    north_turn: f64,
+    /// Lux per sensor per W/m² at each node, by (declination, hour angle) index.
+    nodes: std::collections::HashMap<(i32, i32), Vec<f64>>,
+}
+
+/// The grid's step in declination and hour angle, degrees.
+pub const SUN_PATH_STEP: f64 = 2.5;
+
+impl SunPath {
+    /// Traces the nodes around every sun direction in `suns` (directions in
+    /// the model's frame, as the site's skies give them).
+    pub fn new(coefficients: &SensorCoefficients, site: &Site, suns: &[DVec3], threads: Option<usize>) -> Self {
+        let latitude = site.latitude.to_radians();
+        let mut path = Self { latitude: latitude.sin_cos(), north_turn: site.north_turn.to_radians(), nodes: Default::default() };
+        let mut needed: Vec<(i32, i32)> =
+            suns.iter().flat_map(|&sun| path.cell(sun).0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
+        needed.sort_unstable();
+        let values = par_map(threads, needed.len(), |k| {
+            let direction = path.direction(needed[k]);
+            let sun = SunSource { direction, solid_angle: 1.0, radiance: 1.0 };
+            let beams = coefficients.model.sun_beams(&sun);
+            let mut lux = vec![0.0; coefficients.model.sensors.len()];
+            add_products(
+                &mut lux,
+                coefficients.later_bounces(&coefficients.model.sun_on_sides(&beams, Some(&coefficients.seen), Some(1)).irradiance),
+            );
+            lux
+        });
+        path.nodes = needed.into_iter().zip(values).collect();
+        path
+    }
+
+    /// The sun's light beyond its first bounce per W/m² of direct normal
+    /// irradiance at each sensor, for a sun direction whose nodes were traced.
+    pub fn later_bounces(&self, sun: DVec3) -> Vec<f64> {
+        let (corners, weights) = self.cell(sun);
+        let mut lux = vec![0.0; self.nodes.values().next().map_or(0, Vec::len)];
+        for (corner, weight) in corners.iter().zip(weights) {
+            let node = &self.nodes[corner];
+            for (e, v) in lux.iter_mut().zip(node) {
+                *e += weight * v;
+            }
+        }
+        lux
+    }
+
+    /// The four nodes around a sun direction and their bilinear weights.
+    fn cell(&self, sun: DVec3) -> ([(i32, i32); 4], [f64; 4]) {
+        let (sin_lat, cos_lat) = self.latitude;
+        let (s, c) = self.north_turn.sin_cos();
+        // Back to true north, then to the equatorial frame.
+        let (x, y, z) = (sun.x * c - sun.y * s, sun.y * c + sun.x * s, sun.z);
+        let declination = (y * cos_lat + z * sin_lat).clamp(-1.0, 1.0).asin();
+        let hour_angle = (-x).atan2(z * cos_lat - y * sin_lat);
+        let step = SUN_PATH_STEP.to_radians();
+        let (d, h) = (declination / step, hour_angle / step);
+        let (d0, h0) = (d.floor(), h.floor());
+        let (fd, fh) = (d - d0, h - h0);
+        let (d0, h0) = (d0 as i32, h0 as i32);
+        ([(d0, h0), (d0 + 1, h0), (d0, h0 + 1), (d0 + 1, h0 + 1)], [(1.0 - fd) * (1.0 - fh), fd * (1.0 - fh), (1.0 - fd) * fh, fd * fh])
+    }
+
+    /// A node's sun direction in the model's frame; below the horizon,
+    /// lifted just above it (the light near sunrise is read between a node
+    /// above and one below, and should not fade to the node's darkness).
+    fn direction(&self, (d, h): (i32, i32)) -> DVec3 {
+        let (sin_lat, cos_lat) = self.latitude;
+        let step = SUN_PATH_STEP.to_radians();
+        let (declination, hour_angle) = (f64::from(d) * step, f64::from(h) * step);
+        let x = -declination.cos() * hour_angle.sin();
+        let y = cos_lat * declination.sin() - sin_lat * declination.cos() * hour_angle.cos();
+        let z = (sin_lat * declination.sin() + cos_lat * declination.cos() * hour_angle.cos()).max(MIN_SUN_HEIGHT);
+        let (s, c) = self.north_turn.sin_cos();
+        DVec3::new(x * c + y * s, y * c - x * s, z).normalize()
+    }
+}
+
+/// The sine of the lowest altitude a node's sun is traced at.
+const MIN_SUN_HEIGHT: f64 = 0.01;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Sun directions map to (declination, hour angle) and back, on a turned
+    /// site too; the bilinear weights sum to 1.
+    #[test]
+    fn the_sun_path_grid_maps_directions_both_ways() {
+        for (latitude, turn) in [(42.36, 0.0), (-33.9, 25.0), (64.1, -140.0)] {
+            let site = Site { north_turn: turn, ..Site::new(latitude, 0.0, 0.0) };
+            let path = SunPath { latitude: site.latitude.to_radians().sin_cos(), north_turn: turn.to_radians(), nodes: Default::default() };
+            for (altitude, azimuth) in [(10.0, 95.0), (45.0, 180.0), (70.0, 250.0), (3.0, 300.0)] {
+                let sun = crate::sun::direction_from_angles(altitude, azimuth + turn);
+                let (corners, weights) = path.cell(sun);
+                assert!((weights.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+                // Bilinear in (declination, hour angle): the corners' directions,
+                // weighted, land near the sun (the grid is fine).
+                let blended: DVec3 = corners.iter().zip(weights).map(|(&c, w)| path.direction(c) * w).sum();
+                assert!(
+                    blended.normalize().angle_between(sun).to_degrees() < 0.2,
+                    "{latitude} {turn} {altitude} {azimuth}: {blended} vs {sun}"
+                );
+            }
+        }
     }
 }

@@ -45,7 +45,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-pub use coefficients::SensorCoefficients;
+pub use coefficients::{SensorCoefficients, SunPath};
 pub use gather::{Gather, SkyKey, sensor_points, side_of};
 pub use glass::Glass;
 pub use panels::{PanelFrame, SunBeam};
@@ -86,6 +86,9 @@ pub struct LightModel {
     /// The sky and ground bins daylight coefficients refer to.
     pub sky_bins: SkyPatches,
     tracer: Tracer,
+    /// The model's own triangles, hits naming their scene surface: fewer
+    /// than the patches' render triangles, for shadow rays toward the sun.
+    shadow_tracer: Tracer,
     surfaces: Vec<Surface>,
     /// The windows by material and outward facing (the one grouping rule).
     pub windows: WindowGroups,
@@ -192,6 +195,10 @@ impl LightModel {
     /// The model with its tracer and materials but nothing gathered yet.
     fn empty(scene: Arc<Scene>, settings: LightSettings) -> Self {
         let tracer = Tracer::new(&scene.patches);
+        let shadow_tracer = Tracer::over(
+            &scene.triangles.iter().map(|t| t.vertices).collect::<Vec<_>>(),
+            scene.surfaces.iter().enumerate().flat_map(|(k, s)| std::iter::repeat_n(k as u32, s.triangles.len())).collect(),
+        );
         let surfaces = scene
             .materials
             .iter()
@@ -219,6 +226,7 @@ impl LightModel {
             scene,
             settings,
             tracer,
+            shadow_tracer,
             surfaces,
             side_gathers: Vec::new(),
             sensors: Vec::new(),
@@ -226,10 +234,14 @@ impl LightModel {
     }
 
     fn surface_of_patch(&self, patch: u32) -> Surface {
-        let patch = &self.scene.patches.patches[patch as usize];
-        match self.group_of_surface[patch.surface as usize] {
+        self.surface_kind(self.scene.patches.patches[patch as usize].surface)
+    }
+
+    /// What scene surface `surface` does to rays.
+    fn surface_kind(&self, surface: u32) -> Surface {
+        match self.group_of_surface[surface as usize] {
             Some(group) => Surface::Panel(group),
-            None => self.surfaces[patch.material as usize],
+            None => self.surfaces[self.scene.surfaces[surface as usize].material as usize],
         }
     }
 

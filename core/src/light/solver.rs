@@ -157,8 +157,12 @@ impl LightModel {
         // Each sensor's direct light and the first bounce of sun where its rays land.
         let sensors: Vec<SensorDirect> = par_map(self.settings.threads, self.sensors.len(), |i| {
             let geometry = &self.sensors[i];
-            let (sun, sun_bounce) = self.sensor_sun(i, &beams, &sides_sun.reach);
-            SensorDirect { sky: seen.sky_irradiance(&geometry.gather), sun: seen.panel_sun_irradiance(&geometry.gather) + sun, sun_bounce }
+            let sun = seen.panel_sun_irradiance(&geometry.gather) + self.sensor_direct_sun(i, &beams);
+            SensorDirect {
+                sky: seen.sky_irradiance(&geometry.gather),
+                sun,
+                sun_bounce: self.sensor_sun_bounce(i, &beams, &sides_sun.reach),
+            }
         });
         let warm = warm.filter(|w| w.sides.len() == direct.len()).map(|w| {
             // Scaled by how much the direct light changed: close when the

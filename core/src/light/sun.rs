@@ -61,19 +61,19 @@ impl LightModel {
         // (A few at most: kept on the stack, shadow rays are many.)
         let mut crossed = [(u32::MAX, 0.0); 16];
         let mut count = 0;
-        self.tracer.each_hit(point, sun, 1e-6, |hit| {
-            let patch = &self.scene.patches.patches[hit.patch as usize];
-            match self.surface_of_patch(hit.patch) {
+        self.shadow_tracer.each_hit(point, sun, 1e-6, |hit| {
+            let (surface, normal) = (hit.patch, self.scene.surfaces[hit.patch as usize].normal);
+            match self.surface_kind(surface) {
                 // Through a panel the sun arrives only along its lobes.
                 Surface::Diffuse(_) | Surface::Panel(_) => {
                     transmittance = 0.0;
                     false
                 }
                 Surface::Glass(glass) => {
-                    if !crossed[..count].iter().any(|&(s, d)| s == patch.surface && (d - hit.distance).abs() < 1e-5) {
-                        crossed[count.min(15)] = (patch.surface, hit.distance);
+                    if !crossed[..count].iter().any(|&(s, d)| s == surface && (d - hit.distance).abs() < 1e-5) {
+                        crossed[count.min(15)] = (surface, hit.distance);
                         count = (count + 1).min(16);
-                        transmittance *= glass.at(sun.dot(patch.normal.as_dvec3())).0;
+                        transmittance *= glass.at(sun.dot(normal.as_dvec3())).0;
                     }
                     true
                 }
@@ -88,11 +88,13 @@ impl LightModel {
     fn lobe_transmittance(&self, point: DVec3, to_light: DVec3, group: u32, sun: DVec3) -> f64 {
         let (mut origin, mut transmittance) = (point, 1.0);
         for _ in 0..=MAX_GLASS_DEPTH {
-            let Some(hit) = self.tracer.closest(origin, to_light, 1e-6) else { return 0.0 };
+            let Some(hit) = self.shadow_tracer.closest(origin, to_light, 1e-6) else { return 0.0 };
             let at = origin + to_light * hit.distance;
-            match self.surface_of_patch(hit.patch) {
+            match self.surface_kind(hit.patch) {
                 Surface::Panel(g) if g == group => return transmittance * self.sun_transmittance(at + sun * SURFACE_OFFSET, sun),
-                Surface::Glass(glass) => transmittance *= glass.at(to_light.dot(self.patch_normal(hit.patch))).0,
+                Surface::Glass(glass) => {
+                    transmittance *= glass.at(to_light.dot(self.scene.surfaces[hit.patch as usize].normal.as_dvec3())).0
+                }
                 _ => return 0.0,
             }
             origin = at + to_light * SURFACE_OFFSET;
@@ -115,28 +117,14 @@ impl LightModel {
     pub(super) fn sun_on_sides(&self, beams: &[SunBeam], wanted: Option<&[bool]>, threads: Option<usize>) -> SidesSun {
         let patches = &self.scene.patches.patches;
         let sides: Vec<(f64, Reach)> = par_map(threads, patches.len() * 2, |side| {
-            let patch = &patches[side / 2];
-            if beams.is_empty()
-                || wanted.is_some_and(|w| !w[side])
-                || !matches!(self.surfaces[patch.material as usize], Surface::Diffuse(_))
-            {
-                return (0.0, Reach::None);
-            }
-            let normal = self.side_normal(side as u32);
-            let reach = match () {
-                _ if !beams.iter().any(|b| normal.dot(b.to_light) > 0.0) => Reach::None,
-                _ if self.side_is_open(side) => Reach::Open,
-                _ => match self.openings.ways_in(side / 2, beams) {
-                    ways if ways.is_empty() => Reach::None,
-                    ways => Reach::Through(ways),
-                },
-            };
+            let reach = self.side_reach(side, beams, wanted);
             if reach == Reach::None {
                 return (0.0, reach);
             }
             let triangles = self.patch_triangles(side / 2);
             let mut rng = Rng::new(3, side as u64);
             let n = self.settings.sun_samples_per_patch;
+            let normal = self.side_normal(side as u32);
             let total: f64 = (0..n)
                 .map(|_| sample_area(&triangles, &mut rng))
                 .filter(|&point| reach.may_reach(&self.openings, point, beams))
@@ -148,15 +136,42 @@ impl LightModel {
         SidesSun { irradiance, reach }
     }
 
-    /// Sensor `index`'s direct sun (W/m², averaged over its sun points) and
-    /// the first bounce of the beams off the sides its rays meet (RGB W/m²,
-    /// evaluated where each ray lands), given how beams `reach` each side.
-    pub(super) fn sensor_sun(&self, index: usize, beams: &[SunBeam], reach: &[Reach]) -> (f64, [f64; 3]) {
-        let geometry = &self.sensors[index];
-        if beams.is_empty() {
-            return (0.0, [0.0; 3]);
+    /// How beams may reach every diffuse patch side (none but the sides
+    /// `wanted`, when given), without tracing.
+    pub(super) fn sides_reach(&self, beams: &[SunBeam], wanted: Option<&[bool]>, threads: Option<usize>) -> Vec<Reach> {
+        par_map(threads, self.side_gathers.len(), |side| self.side_reach(side, beams, wanted))
+    }
+
+    fn side_reach(&self, side: usize, beams: &[SunBeam], wanted: Option<&[bool]>) -> Reach {
+        let patch = &self.scene.patches.patches[side / 2];
+        if beams.is_empty() || wanted.is_some_and(|w| !w[side]) || !matches!(self.surfaces[patch.material as usize], Surface::Diffuse(_)) {
+            return Reach::None;
         }
-        let direct: f64 = geometry.sun_points.iter().map(|&p| self.beams_irradiance(p, geometry.normal, beams)).sum();
+        let normal = self.side_normal(side as u32);
+        if !beams.iter().any(|b| normal.dot(b.to_light) > 0.0) {
+            Reach::None
+        } else if self.side_is_open(side) {
+            Reach::Open
+        } else {
+            match self.openings.ways_in(side / 2, beams) {
+                ways if ways.is_empty() => Reach::None,
+                ways => Reach::Through(ways),
+            }
+        }
+    }
+
+    /// Sensor `index`'s direct sun (W/m², averaged over its sun points).
+    pub(super) fn sensor_direct_sun(&self, index: usize, beams: &[SunBeam]) -> f64 {
+        let geometry = &self.sensors[index];
+        let total: f64 = geometry.sun_points.iter().map(|&p| self.beams_irradiance(p, geometry.normal, beams)).sum();
+        total / geometry.sun_points.len() as f64
+    }
+
+    /// The first bounce of the beams off the sides sensor `index`'s rays
+    /// meet (RGB W/m², evaluated where each ray lands), given how beams
+    /// `reach` each side.
+    pub(super) fn sensor_sun_bounce(&self, index: usize, beams: &[SunBeam], reach: &[Reach]) -> [f64; 3] {
+        let geometry = &self.sensors[index];
         let mut bounce = [0.0; 3];
         for run in geometry.hits_by_side() {
             let side = run[0].0;
@@ -176,7 +191,7 @@ impl LightModel {
                 }
             }
         }
-        (direct / geometry.sun_points.len() as f64, bounce)
+        bounce
     }
 
     /// Direct sun irradiance (W/m²) from all `beams` at `point` on a surface

@@ -1,0 +1,70 @@
+//! The annual study's costs on a real year of weather (Chicago TMY3 from
+//! ../shared/data/weather, or the EPW named by `HELIODON_BENCH_EPW`): the
+//! bundled office (150 sensors) and the validation side room (19), cold
+//! (gather, coefficients and the year) and with the light model warm
+//! (coefficients and the year: what `annual` does when the cache is warm).
+//! The parts are printed once beside the measurements.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use heliodon_core::annual::{Occupancy, annual};
+use heliodon_core::light::{LightModel, LightSettings};
+use heliodon_core::panel::PanelCatalog;
+use heliodon_core::scene::{Scene, load_scene};
+use heliodon_core::weather::Weather;
+
+fn weather() -> Weather {
+    let path = std::env::var_os("HELIODON_BENCH_EPW")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/weather/chicago.epw"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e} (set HELIODON_BENCH_EPW to an EPW file)", path.display()));
+    Weather::parse_epw(&text, &path).unwrap()
+}
+
+fn scenes() -> Vec<(&'static str, Arc<Scene>)> {
+    let load = |path: PathBuf| Arc::new(load_scene(&path, &PanelCatalog::new()).unwrap().scene);
+    vec![
+        ("office", load(heliodon_core::bundled_scene("office"))),
+        ("side room", load(Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/sideroom/scene.toml"))),
+    ]
+}
+
+fn year(model: &LightModel, weather: &Weather) -> f64 {
+    let result = annual(model, &model.scene.site, weather, Occupancy::default(), false, &|_| {});
+    result.sda()
+}
+
+fn bench(c: &mut Criterion) {
+    let weather = weather();
+    let mut group = c.benchmark_group("annual");
+    group.sample_size(10).measurement_time(Duration::from_secs(60));
+    for (name, scene) in scenes() {
+        let start = Instant::now();
+        let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
+        let gathered = start.elapsed();
+        let coefficients = model.sensor_coefficients();
+        let folded = start.elapsed() - gathered;
+        drop(coefficients);
+        let sda = year(&model, &weather);
+        let total = start.elapsed();
+        println!(
+            "{name}: {} sensors, {} patches; gather {:.2} s, coefficients {:.2} s, year (coefficients included) {:.2} s; sDA {sda:.1}%",
+            scene.sensors.len(),
+            scene.patches.patches.len(),
+            gathered.as_secs_f64(),
+            folded.as_secs_f64(),
+            (total - gathered).as_secs_f64()
+        );
+        group.bench_function(format!("{name}: year, light model warm"), |b| b.iter(|| year(&model, &weather)));
+        group.bench_function(format!("{name}: year, cold"), |b| {
+            b.iter(|| year(&LightModel::precompute(scene.clone(), LightSettings::default()).unwrap(), &weather))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
