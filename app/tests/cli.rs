@@ -478,10 +478,9 @@ fn annual_refuses_bad_weather_and_scenes_without_sensors_in_one_line() {
     assert_eq!(code, 2);
     assert!(err.contains("--occupied") && err.contains("the end is not after the start"), "{err}");
 
-    // Shade groups: checked where they are read; the study refuses them until they are modelled.
+    // Shade groups: checked where they are read.
     let blinds = "\n[materials.blinds]\nkind = \"glass\"\ntransmittance = 0.1\n";
     let cases = [
-        ("[[shades]]\nwindows = \"glass\"\nshade = \"blinds\"\n", "operable shades are not modelled yet"),
         ("[[shades]]\nwindows = \"wall\"\nshade = \"blinds\"\n", "shades[0].windows: 'wall' is not a window material (glass or panel)"),
         ("[[shades]]\nwindows = \"glass\"\nshade = \"curtain\"\n", "shades[0].shade: 'curtain' is not a material of [materials]"),
     ];
@@ -492,12 +491,78 @@ fn annual_refuses_bad_weather_and_scenes_without_sensors_in_one_line() {
         assert!(err.lines().filter(|l| l.starts_with("error")).count() == 1 && err.contains(expected), "{shades}: {err}");
         assert!(!err.contains("no face"), "the shade material is not unused: {err}");
     }
-    let scene = test_room_with("annual_shades", &format!("{blinds}\n{}", cases[0].0));
-    let args = ["annual", scene.to_str().unwrap(), "--weather", full.to_str().unwrap(), "--no-shades", "--format", "json"];
-    let Run { code, out, err } = heliodon(&args, &scratch());
-    assert_eq!(code, 0, "{err}");
-    assert!(out.starts_with("{\"weather\": ") && out.contains("\"sda300_50\": ") && out.contains("\"ase1000_250\": "), "{out}");
-    assert!(!err.contains("no face"), "the shade material is not unused: {err}");
+}
+
+/// LM-83 operable shades: an occupied hour lowers the shade exactly when
+/// more than 2% of the point sensors get 1000 lux or more of direct sun
+/// through its windows (here every window); with it down the hour reads
+/// less light, and ASE is counted with every shade up.
+#[test]
+fn annual_lowers_operable_shades_hour_by_hour() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("annual_lm83");
+    std::fs::create_dir_all(&dir).unwrap();
+    let epw = dir.join("boston.epw");
+    std::fs::write(&epw, boston_epw(8760)).unwrap();
+    let shades = "\n[materials.blinds]\nkind = \"glass\"\ntransmittance = 0.1\n\n[[shades]]\nwindows = \"glass\"\nshade = \"blinds\"\n";
+    let scene = test_room_with("annual_lm83", shades);
+    let year = |extra: &[&str], hourly: &Path| {
+        let args = [&["annual", scene.to_str().unwrap(), "--weather", epw.to_str().unwrap(), "--hourly", hourly.to_str().unwrap()], extra]
+            .concat();
+        let Run { code, out, err } = heliodon(&args, &scratch());
+        assert_eq!(code, 0, "{err}");
+        assert!(!err.contains("no face"), "the shade material is not unused: {err}");
+        let hours: Vec<Vec<f64>> =
+            std::fs::read_to_string(hourly).unwrap().lines().skip(1).map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+        (out, hours)
+    };
+    let (shaded_json, shaded) = year(&["--format", "json"], &dir.join("shaded.csv"));
+    let (open_json, open) = year(&["--format", "json", "--no-shades"], &dir.join("open.csv"));
+    let field = |json: &str, key: &str| -> f64 {
+        let at = json.find(&format!("\"{key}\": ")).unwrap() + key.len() + 4;
+        json[at..].split([',', '}']).next().unwrap().parse().unwrap()
+    };
+    assert_eq!(field(&open_json, "shaded_hours"), 0.0);
+    // The hours the shade was down: occupied, and darker than with it up.
+    let lowered: Vec<usize> = (0..8760).filter(|&k| shaded[k] != open[k]).collect();
+    assert_eq!(lowered.len() as f64, field(&shaded_json, "shaded_hours"), "{shaded_json}");
+    // (The synthetic year has sun on the 21st of March, June, September and
+    // December; the low suns of spring, autumn and winter reach the desks.)
+    assert!(!lowered.is_empty());
+    for &k in &lowered {
+        assert!((9.0..=18.0).contains(&shaded[k][2]), "hour {:?}", &shaded[k][..3]);
+        assert!(
+            shaded[k][3..].iter().zip(&open[k][3..]).all(|(s, o)| s <= o)
+                && shaded[k][3..].iter().sum::<f64>() < open[k][3..].iter().sum::<f64>()
+        );
+    }
+    // The rule, hour by hour, from `sensors`' direct sun at the point sensors
+    // (the area sensors floor-centre and back-wall do not count).
+    for (date, hour) in [("2025-03-21", 9), ("2025-03-21", 13), ("2025-03-21", 17), ("2025-03-21", 18), ("2025-06-21", 13)] {
+        let month: usize = date[5..7].parse().unwrap();
+        let k = ([0, 31, 59, 90, 120, 151][month - 1] + 20) * 24 + hour - 1;
+        let time = format!("{:02}:30", hour - 1);
+        let (dni, dhi) = (60.0 * (hour as f64 - 5.0), 40.0 + 10.0 * (hour % 4) as f64);
+        let args = ["sensors", scene.to_str().unwrap(), "--date", date, "--time", &time, "--sky", "perez", "--no-cache"];
+        let Run { code, out, err } =
+            heliodon(&[&args[..], &["--dni", &dni.to_string(), "--dhi", &dhi.to_string(), "--format", "csv"]].concat(), &scratch());
+        assert_eq!(code, 0, "{err}");
+        let points: Vec<f64> = out
+            .lines()
+            .skip(1)
+            .filter(|l| !l.starts_with("floor-centre,") && !l.starts_with("back-wall,"))
+            .map(|l| l.split(',').nth(2).unwrap().parse().unwrap())
+            .collect();
+        let sunny = points.iter().filter(|&&e| e >= 1000.0).count();
+        assert_eq!(
+            lowered.contains(&k),
+            sunny as f64 > 0.02 * points.len() as f64,
+            "{date} hour {hour}: {sunny} of {} sunny",
+            points.len()
+        );
+    }
+    // ASE with every shade up: the same hours either way.
+    let ase = |json: &str| json.split("\"ase_hours\": ").skip(1).map(|v| v.split('}').next().unwrap().to_string()).collect::<Vec<_>>();
+    assert_eq!(ase(&shaded_json), ase(&open_json));
 }
 
 // ---- panels ----------------------------------------------------------------------

@@ -33,7 +33,7 @@ fn scenes() -> Vec<(&'static str, Arc<Scene>)> {
 }
 
 fn year(model: &LightModel, weather: &Weather) -> f64 {
-    let result = annual(model, &model.scene.site, weather, Occupancy::default(), false, &|_| {});
+    let result = annual(model, &model.scene.site, weather, Occupancy::default(), None, false, &|_| {}).unwrap();
     result.sda()
 }
 

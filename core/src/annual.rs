@@ -24,11 +24,17 @@
 //!    hours, unless every hour is kept for `--hourly`).
 //! 4. ASE counts the direct sun alone (no sky, no interreflection).
 //!
-//! LM-83 operable shades are not modelled yet.
+//! 5. LM-83 operable shades (`[[shades]]`): in each occupied hour a group
+//!    whose windows give more than 2% of the point sensors 1000 lux or more
+//!    of direct sun is lowered; the hour's DA and UDI are read on the model
+//!    with those shades drawn in (one model, coefficients and sun path per
+//!    combination of lowered groups that occurs), ASE with every shade up.
 
-use crate::light::{LightModel, SunPath, par_map};
+use glam::DVec3;
+
+use crate::light::{LightModel, SensorCoefficients, SunPath, par_map};
 use crate::site::Site;
-use crate::sky::{Sky, SkyError, SkySpec, perez, sky_at};
+use crate::sky::{LUMINOUS_EFFICACY, Sky, SkyError, SkySpec, perez, sky_at};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
 use crate::weather::{HOURS, Weather};
 
@@ -88,6 +94,9 @@ impl Occupancy {
 pub struct SensorYear {
     /// The sensor's name.
     pub name: String,
+    /// A point sensor (grid points included), not an area sensor: the
+    /// scene's sDA and ASE count these.
+    pub point: bool,
     /// % of occupied hours with at least [`DA_LUX`].
     pub da300: f64,
     /// % of occupied hours below [`UDI_BAND`].0.
@@ -107,6 +116,8 @@ pub struct AnnualResult {
     pub sensors: Vec<SensorYear>,
     /// Occupied hours of the year.
     pub occupied_hours: usize,
+    /// Occupied hours with some shade group down.
+    pub shaded_hours: usize,
     /// Lit hours whose sky could not be made (they read 0).
     pub skipped_hours: usize,
     /// Total lux of every sensor for every hour, `[hour][sensor]`, when asked for.
@@ -114,22 +125,23 @@ pub struct AnnualResult {
 }
 
 impl AnnualResult {
-    /// sDA300/50%: % of sensors with DA300 ≥ 50%.
+    /// sDA300/50%: % of point sensors with DA300 ≥ 50%.
     pub fn sda(&self) -> f64 {
-        share(&self.sensors, |s| s.da300 >= SDA_SHARE)
+        self.share(|s| s.da300 >= SDA_SHARE)
     }
 
-    /// ASE1000/250: % of sensors with at least 250 hours of direct sun ≥ 1000 lux.
+    /// ASE1000/250: % of point sensors with at least 250 hours of direct sun ≥ 1000 lux.
     pub fn ase(&self) -> f64 {
-        share(&self.sensors, |s| s.ase_hours >= ASE_HOURS)
+        self.share(|s| s.ase_hours >= ASE_HOURS)
     }
-}
 
-fn share(sensors: &[SensorYear], counts: impl Fn(&SensorYear) -> bool) -> f64 {
-    if sensors.is_empty() {
-        return 0.0;
+    fn share(&self, counts: impl Fn(&SensorYear) -> bool) -> f64 {
+        let points: Vec<&SensorYear> = self.sensors.iter().filter(|s| s.point).collect();
+        if points.is_empty() {
+            return 0.0;
+        }
+        100.0 * points.iter().filter(|s| counts(s)).count() as f64 / points.len() as f64
     }
-    100.0 * sensors.iter().filter(|s| counts(s)).count() as f64 / sensors.len() as f64
 }
 
 /// Occupied hours counted per sensor: DA300, UDI low, UDI, UDI high, ASE.
@@ -137,6 +149,8 @@ fn share(sensors: &[SensorYear], counts: impl Fn(&SensorYear) -> bool) -> f64 {
 struct Tally {
     counts: Vec<[u32; 5]>,
     occupied: usize,
+    /// Occupied hours with some shade down.
+    shaded: usize,
     skipped: usize,
 }
 
@@ -145,9 +159,11 @@ impl Tally {
         Self { counts: vec![[0; 5]; sensors], ..Default::default() }
     }
 
-    /// One occupied hour: each sensor's (total, direct sun) lux; `None` when dark.
-    fn count(&mut self, readings: Option<&[(f64, f64)]>) {
+    /// One occupied hour: each sensor's (total, direct sun) lux, `None`
+    /// when dark; `shaded` when some shade was down.
+    fn count(&mut self, readings: Option<&[(f64, f64)]>, shaded: bool) {
         self.occupied += 1;
+        self.shaded += usize::from(shaded);
         for (s, count) in self.counts.iter_mut().enumerate() {
             let (total, sun) = readings.map_or((0.0, 0.0), |r| r[s]);
             count[0] += u32::from(total >= DA_LUX);
@@ -166,6 +182,7 @@ impl Tally {
             }
         }
         self.occupied += other.occupied;
+        self.shaded += other.shaded;
         self.skipped += other.skipped;
         self
     }
@@ -195,65 +212,115 @@ pub fn hour_sky(site: &Site, when: &LocalDateTime, direct_normal: f64, diffuse_h
     sky.map(Some)
 }
 
-/// Runs the year. `keep_hourly` keeps every hour's total lux (8,760 ×
-/// sensors values); `progress` hears the share of days done (from any thread).
+/// Makes the light model of the scene with the given shade groups down
+/// (indices into [`crate::scene::Scene::shades`]), as
+/// [`crate::scene::Scene::with_shades_down`] draws it.
+pub type ShadedModel<'a> = &'a (dyn Fn(&[usize]) -> Result<LightModel, String> + Sync);
+
+/// LM-83's rule: a shade group goes down when more than this share of the
+/// point sensors get [`ASE_LUX`] or more of direct sun through its windows.
+const SHADE_SENSOR_SHARE: f64 = 0.02;
+
+/// Runs the year. With `shades` (the scene's `[[shades]]`, LM-83), every
+/// occupied hour lowers the groups whose windows let too much direct sun
+/// onto the point sensors and reads DA and UDI with them down (ASE always
+/// with every shade up). `keep_hourly` keeps every hour's total lux (8,760
+/// × sensors values); `progress` hears the share of days done (from any
+/// thread). Fails only when a shaded model cannot be made.
 pub fn annual(
     model: &LightModel,
     site: &Site,
     weather: &Weather,
     occupancy: Occupancy,
+    shades: Option<ShadedModel>,
     keep_hourly: bool,
     progress: &(dyn Fn(f64) + Sync),
-) -> AnnualResult {
-    let sensor_count = model.scene.sensors.len();
-    let days = HOURS / 24;
-    let done = std::sync::atomic::AtomicUsize::new(0);
-    // Runs of whole days, one per core: memory follows sensors × cores, not
-    // hours (unless every hour is kept). Each day starts cold, so the split
-    // does not change a number.
-    let runs = std::thread::available_parallelism().map_or(1, |n| n.get());
+) -> Result<AnnualResult, String> {
+    let scene = &model.scene;
+    let sensor_count = scene.sensors.len();
     let coefficients = model.sensor_coefficients();
-    // Every hour's sky first: the sun path is traced around the suns of the lit ones.
+    // Every hour's sky first: the sun paths are traced around the suns of the lit ones.
     let skies: Vec<Result<Option<Sky>, SkyError>> = par_map(None, HOURS, |k| {
         let hour = &weather.hours[k];
         hour_sky(site, &hour_time(hour.month, hour.day, hour.hour), hour.direct_normal, hour.diffuse_horizontal)
     });
-    let suns: Vec<_> = skies.iter().flatten().flatten().filter_map(|sky| sky.sun.map(|s| s.direction)).collect();
-    let sun_path = SunPath::new(&coefficients, site, &suns, None);
+    let lit = |k: usize| skies[k].as_ref().ok().and_then(Option::as_ref);
+    let suns = |hours: &mut dyn Iterator<Item = usize>| -> Vec<DVec3> { hours.filter_map(|k| lit(k)?.sun).map(|s| s.direction).collect() };
+    let sun_path = SunPath::new(&coefficients, site, &suns(&mut (0..HOURS)), None);
+
+    // Which shade groups are down in each hour (a bit per group), and the
+    // light with each combination that occurs.
+    let groups = if shades.is_some() { scene.shades.len() } else { 0 };
+    if groups > 16 {
+        return Err(format!("{} shade groups: at most 16 are studied together", groups));
+    }
+    let down: Vec<u32> = par_map(None, HOURS, |k| match lit(k) {
+        Some(sky) if groups > 0 && occupancy.contains(weather.hours[k].hour) => shades_down(model, sky),
+        _ => 0,
+    });
+    let combinations: std::collections::BTreeSet<u32> = down.iter().copied().filter(|&m| m != 0).collect();
+    let shaded_models: Vec<(u32, LightModel)> = combinations
+        .into_iter()
+        .map(|mask| {
+            let lowered: Vec<usize> = (0..groups).filter(|g| mask & (1 << g) != 0).collect();
+            Ok((mask, shades.expect("shades are studied")(&lowered)?))
+        })
+        .collect::<Result<_, String>>()?;
+    let shaded: Vec<(u32, SensorCoefficients, SunPath)> = shaded_models
+        .iter()
+        .map(|(mask, model)| {
+            let coefficients = model.sensor_coefficients();
+            let path = SunPath::new(&coefficients, site, &suns(&mut (0..HOURS).filter(|&k| down[k] == *mask)), None);
+            (*mask, coefficients, path)
+        })
+        .collect();
+
+    let days = HOURS / 24;
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    // Runs of whole days, one per core: memory follows sensors × cores, not
+    // hours (unless every hour is kept). Hours are independent, so the
+    // split does not change a number.
+    let runs = std::thread::available_parallelism().map_or(1, |n| n.get());
     let year: Vec<(Tally, Vec<Vec<f32>>)> = par_map(None, runs, |run| {
         let mut tally = Tally::new(sensor_count);
         let mut hourly = Vec::new();
-        for day in run * days / runs..(run + 1) * days / runs {
-            for (hour, sky) in weather.hours[day * 24..day * 24 + 24].iter().zip(&skies[day * 24..day * 24 + 24]) {
-                let sky = sky.as_ref().unwrap_or_else(|_| {
-                    tally.skipped += 1;
-                    &None
-                });
-                let readings: Option<Vec<(f64, f64)>> = sky
-                    .as_ref()
-                    .map(|sky| coefficients.readings_on_path(sky, &sun_path, Some(1)).iter().map(|r| (r.total, r.direct_sun)).collect());
-                if occupancy.contains(hour.hour) {
-                    tally.count(readings.as_deref());
+        for k in run * days / runs * 24..(run + 1) * days / runs * 24 {
+            let hour = &weather.hours[k];
+            tally.skipped += usize::from(skies[k].is_err());
+            // (total with the hour's shades, direct sun with every shade up) per sensor.
+            let readings: Option<Vec<(f64, f64)>> = lit(k).map(|sky| {
+                let up = coefficients.readings_on_path(sky, &sun_path, Some(1));
+                match shaded.iter().find(|(mask, ..)| *mask == down[k]) {
+                    Some((_, coefficients, path)) => {
+                        let lowered = coefficients.readings_on_path(sky, path, Some(1));
+                        lowered.iter().zip(&up).map(|(l, u)| (l.total, u.direct_sun)).collect()
+                    }
+                    None => up.iter().map(|r| (r.total, r.direct_sun)).collect(),
                 }
-                if keep_hourly {
-                    hourly.push(readings.map_or_else(|| vec![0.0; sensor_count], |r| r.iter().map(|v| v.0 as f32).collect()));
-                }
+            });
+            if occupancy.contains(hour.hour) {
+                tally.count(readings.as_deref(), down[k] != 0);
             }
-            let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            progress(finished as f64 / days as f64);
+            if keep_hourly {
+                hourly.push(readings.map_or_else(|| vec![0.0; sensor_count], |r| r.iter().map(|v| v.0 as f32).collect()));
+            }
+            if hour.hour == 24 {
+                let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress(finished as f64 / days as f64);
+            }
         }
         (tally, hourly)
     });
     let tally = year.iter().fold(Tally::new(sensor_count), |sum, (run, _)| sum.merge(run));
     let occupied_hours = tally.occupied;
     let percent = |n: u32| if occupied_hours == 0 { 0.0 } else { 100.0 * f64::from(n) / occupied_hours as f64 };
-    let sensors = model
-        .scene
+    let sensors = scene
         .sensors
         .iter()
         .zip(&tally.counts)
         .map(|(sensor, c)| SensorYear {
             name: sensor.name.clone(),
+            point: sensor.size.is_none(),
             da300: percent(c[0]),
             udi_low: percent(c[1]),
             udi: percent(c[2]),
@@ -262,7 +329,30 @@ pub fn annual(
         })
         .collect();
     let hourly = keep_hourly.then(|| year.into_iter().flat_map(|(_, hours)| hours).collect());
-    AnnualResult { sensors, occupied_hours, skipped_hours: tally.skipped, hourly }
+    Ok(AnnualResult { sensors, occupied_hours, shaded_hours: tally.shaded, skipped_hours: tally.skipped, hourly })
+}
+
+/// The shade groups (a bit each) that LM-83 lowers under `sky`: more than
+/// 2% of the point sensors get at least [`ASE_LUX`] of direct sun through
+/// the group's windows.
+fn shades_down(model: &LightModel, sky: &Sky) -> u32 {
+    let scene = &model.scene;
+    let Some(sun) = sky.sun.filter(|s| s.direction.z > 0.0) else { return 0 };
+    let beams = model.sun_beams(&sun);
+    let points: Vec<usize> = (0..scene.sensors.len()).filter(|&i| scene.sensors[i].size.is_none()).collect();
+    let mut sunny = vec![0usize; scene.shades.len()];
+    for &i in &points {
+        let by_window = model.sensor_sun_by_window(i, &beams);
+        for (g, group) in scene.shades.iter().enumerate() {
+            let through: f64 = by_window
+                .iter()
+                .filter(|(w, _)| w.is_some_and(|w| scene.windows[w as usize].material == group.windows))
+                .map(|(_, e)| e)
+                .sum();
+            sunny[g] += usize::from(through * LUMINOUS_EFFICACY >= ASE_LUX);
+        }
+    }
+    sunny.iter().enumerate().filter(|&(_, &n)| n as f64 > SHADE_SENSOR_SHARE * points.len() as f64).fold(0, |mask, (g, _)| mask | 1 << g)
 }
 
 #[cfg(test)]

@@ -199,19 +199,47 @@ impl LightModel {
     pub fn beams_irradiance(&self, point: DVec3, normal: DVec3, beams: &[SunBeam]) -> f64 {
         let sun = beams.first().map_or(DVec3::Z, |b| b.to_light);
         let origin = point + normal * SURFACE_OFFSET;
-        beams
-            .iter()
-            .map(|beam| {
-                let cos = normal.dot(beam.to_light);
-                if cos <= 0.0 {
-                    return 0.0;
+        beams.iter().map(|beam| self.beam_irradiance(origin, normal, beam, sun)).sum()
+    }
+
+    /// One beam's irradiance at `origin` (already off its surface), with
+    /// `sun` the real sun's direction.
+    fn beam_irradiance(&self, origin: DVec3, normal: DVec3, beam: &SunBeam, sun: DVec3) -> f64 {
+        let cos = normal.dot(beam.to_light);
+        if cos <= 0.0 {
+            return 0.0;
+        }
+        let reach = match beam.panel_group {
+            None => self.sun_transmittance(origin, beam.to_light),
+            Some(group) => self.lobe_transmittance(origin, beam.to_light, group, sun),
+        };
+        beam.normal_irradiance * cos * reach
+    }
+
+    /// Sensor `index`'s direct sun (W/m², averaged over its sun points) by
+    /// the window it comes through last (index into [`Scene::windows`];
+    /// `None`: straight from the sky).
+    ///
+    /// [`Scene::windows`]: crate::scene::Scene::windows
+    pub fn sensor_sun_by_window(&self, index: usize, beams: &[SunBeam]) -> Vec<(Option<u32>, f64)> {
+        let geometry = &self.sensors[index];
+        let sun = beams.first().map_or(DVec3::Z, |b| b.to_light);
+        let mut by_window: Vec<(Option<u32>, f64)> = Vec::new();
+        let share = 1.0 / geometry.sun_points.len() as f64;
+        for &point in &geometry.sun_points {
+            let origin = point + geometry.normal * SURFACE_OFFSET;
+            for beam in beams {
+                let e = self.beam_irradiance(origin, geometry.normal, beam, sun);
+                if e > 0.0 {
+                    let hit = self.shadow_tracer.closest(origin, beam.to_light, 1e-6);
+                    let window = hit.and_then(|h| self.window_of_surface[h.patch as usize]);
+                    match by_window.iter_mut().find(|w| w.0 == window) {
+                        Some(entry) => entry.1 += e * share,
+                        None => by_window.push((window, e * share)),
+                    }
                 }
-                let reach = match beam.panel_group {
-                    None => self.sun_transmittance(origin, beam.to_light),
-                    Some(group) => self.lobe_transmittance(origin, beam.to_light, group, sun),
-                };
-                beam.normal_irradiance * cos * reach
-            })
-            .sum()
+            }
+        }
+        by_window
     }
 }

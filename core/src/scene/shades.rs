@@ -4,6 +4,7 @@
 
 use std::collections::BTreeMap;
 
+use super::Scene;
 use super::error::SceneError;
 use super::file::ParsedScene;
 use super::material::{Material, MaterialKind};
@@ -56,4 +57,33 @@ pub fn shade_groups(
             Ok(ShadeGroup { windows: index as u32, shade: material.clone() })
         })
         .collect()
+}
+
+impl Scene {
+    /// The scene with the shades of groups `down` (indices into
+    /// [`Scene::shades`]) lowered: their windows drawn in the shade's
+    /// material. Geometry, patches and sensors stay as they are.
+    pub fn with_shades_down(&self, down: &[usize]) -> Scene {
+        let mut scene = self.clone();
+        for &group in down {
+            let ShadeGroup { windows, shade } = &self.shades[group];
+            let index = match scene.materials.iter().position(|m| m.name == shade.name) {
+                Some(index) => index as u32,
+                None => {
+                    scene.materials.push(shade.clone());
+                    scene.materials.len() as u32 - 1
+                }
+            };
+            let swap = |material: &mut u32| {
+                if material == windows {
+                    *material = index;
+                }
+            };
+            scene.triangles.iter_mut().for_each(|t| swap(&mut t.material));
+            scene.surfaces.iter_mut().for_each(|s| swap(&mut s.material));
+            scene.patches.patches.iter_mut().for_each(|p| swap(&mut p.material));
+            scene.windows.iter_mut().for_each(|w| swap(&mut w.material));
+        }
+        scene
+    }
 }

@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use crate::annual::{AnnualResult, Occupancy, annual, hour_time};
+use crate::annual::{AnnualResult, Occupancy, ShadedModel, annual, hour_time};
 use crate::cli::CliError;
 use crate::cli::args::{Format, load_for_command, precompute_for_command, progress_bar};
 use crate::panel::PanelCatalog;
@@ -27,7 +27,7 @@ pub struct AnnualArgs {
     /// Also write every sensor's total lux for every hour (8,760 rows) to this CSV file
     #[arg(long, value_name = "FILE.csv")]
     pub hourly: Option<PathBuf>,
-    /// Ignore the scene's [[shades]] (operable shades are not modelled yet: without this flag a scene with shades is refused)
+    /// Ignore the scene's [[shades]]: every hour with the windows as modelled
     #[arg(long)]
     pub no_shades: bool,
     /// Neither read nor write the precomputation cache
@@ -41,12 +41,6 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     if scene.sensors.is_empty() {
         return Err(CliError::failure(format!(
             "{}: the scene has no sensors; an annual study reads sensors ([[sensors]] or [[sensor_grids]])",
-            args.scene.display()
-        )));
-    }
-    if !scene.shades.is_empty() && !args.no_shades {
-        return Err(CliError::failure(format!(
-            "{}: [[shades]]: operable shades are not modelled yet; --no-shades counts every hour with the windows as modelled",
             args.scene.display()
         )));
     }
@@ -80,10 +74,13 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     }
 
     let model = precompute_for_command(scene.clone(), args.no_cache)?;
+    let shaded = |down: &[usize]| precompute_for_command(std::sync::Arc::new(scene.with_shades_down(down)), args.no_cache);
+    let shades: Option<ShadedModel> = (!scene.shades.is_empty() && !args.no_shades).then_some(&shaded);
     let progress = progress_bar("a year of hours");
     let result =
-        annual(&model, site, &weather, args.occupied, args.hourly.is_some(), &|done| progress.set_position((done * 1000.0) as u64));
+        annual(&model, site, &weather, args.occupied, shades, args.hourly.is_some(), &|done| progress.set_position((done * 1000.0) as u64));
     progress.finish_and_clear();
+    let result = result?;
     if result.skipped_hours > 0 {
         eprintln!("warning: {}: {} lit hours gave no Perez sky; they read 0 lux", args.weather.display(), result.skipped_hours);
     }
@@ -139,9 +136,10 @@ fn report(result: &AnnualResult, format: Format, weather_path: &std::path::Path)
                 .collect();
             let _ = writeln!(
                 out,
-                "{{\"weather\": {}, \"occupied_hours\": {}, \"sda300_50\": {:.1}, \"ase1000_250\": {:.1}, \"sensors\": [{}]}}",
+                "{{\"weather\": {}, \"occupied_hours\": {}, \"shaded_hours\": {}, \"sda300_50\": {:.1}, \"ase1000_250\": {:.1}, \"sensors\": [{}]}}",
                 json_string(&weather_path.display().to_string()),
                 result.occupied_hours,
+                result.shaded_hours,
                 result.sda(),
                 result.ase(),
                 rows.join(", ")
@@ -149,6 +147,9 @@ fn report(result: &AnnualResult, format: Format, weather_path: &std::path::Path)
         }
         Format::Table => {
             let _ = writeln!(out, "{}: {} occupied hours", weather_path.display(), result.occupied_hours);
+            if result.shaded_hours > 0 {
+                let _ = writeln!(out, "shades down in {} of them (IES LM-83)", result.shaded_hours);
+            }
             let _ = writeln!(out, "sDA300/50%  {:.1}% of sensors", result.sda());
             let _ = writeln!(out, "ASE1000/250 {:.1}% of sensors", result.ase());
             let _ = writeln!(out, "{:<20} {:>7} {:>8} {:>7} {:>9} {:>9}", "sensor", "DA300 %", "UDI<100", "UDI %", "UDI>3000", "ASE h");
