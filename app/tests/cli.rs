@@ -622,3 +622,189 @@ fn bad_panel_keys_give_one_line_naming_the_key() {
         assert!(err.contains(expected), "{name}: {err}");
     }
 }
+
+// ---- sweeps -----------------------------------------------------------------------
+
+/// The bundled prismatic room copied into `folder` with its panel's facet
+/// angles set, the scene's path (what a designer would write by hand).
+fn prismatic_room_with(folder: &str, angles: [f64; 2]) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(folder);
+    std::fs::create_dir_all(&dir).unwrap();
+    let room = bundled_scene("prismatic_room");
+    for entry in std::fs::read_dir(room.parent().unwrap()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "obj" || e == "mtl") {
+            std::fs::copy(&path, dir.join(path.file_name().unwrap())).unwrap();
+        }
+    }
+    let text = std::fs::read_to_string(&room).unwrap();
+    assert!(text.contains("facet_angles = [40.0, 5.0]"));
+    let text = text.replace("facet_angles = [40.0, 5.0]", &format!("facet_angles = [{:?}, {:?}]", angles[0], angles[1]));
+    std::fs::write(dir.join("scene.toml"), text).unwrap();
+    dir.join("scene.toml")
+}
+
+/// Rows of a sweep's CSV: (key values, sensor, value or error).
+fn sweep_rows(csv: &str) -> Vec<(Vec<String>, String, String)> {
+    csv.lines()
+        .skip(1)
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| {
+            let f: Vec<&str> = l.splitn(4, ',').collect();
+            (vec![f[0].to_string(), f[1].to_string()], f[2].to_string(), f[3].to_string())
+        })
+        .collect()
+}
+
+/// Every combination of a sweep reads what `sensors` reads on a scene file
+/// with those keys (within 0.5%); a combination the panel refuses is
+/// reported in its rows and the run succeeds; shards merged are the
+/// unsharded output, byte for byte.
+#[test]
+fn sweeps_read_what_scene_files_with_those_keys_read() {
+    let room = bundled_scene("prismatic_room");
+    let at = ["--date", "2025-12-21", "--time", "11:00", "--sky", "clear"];
+    let base = [
+        "sweep",
+        room.to_str().unwrap(),
+        "--material",
+        "upper",
+        "--vary",
+        "facet_angles[0]=0..40:20",
+        "--vary",
+        "facet_angles[1]=0..10:10",
+        "--all-sensors",
+        "--format",
+        "csv",
+    ];
+    let Run { code, out, err } = heliodon(&[&base[..], &at[..]].concat(), &scratch());
+    assert_eq!(code, 0, "{err}");
+    assert!(out.starts_with("facet_angles[0],facet_angles[1],sensor,value\n"), "{out}");
+    let rows = sweep_rows(&out);
+    let sensors = rows.iter().take_while(|r| r.0 == rows[0].0).count();
+    assert!(sensors > 5);
+    assert_eq!(rows.len(), 6 * sensors);
+    // Both facets flat: the panel refuses it, in its rows.
+    assert!(rows[..sensors].iter().all(|r| r.0 == ["0", "0"] && r.2.starts_with("error: facet_angles: ")), "{:?}", &rows[0]);
+    for (a, b) in [(20.0, 0.0), (40.0, 10.0), (0.0, 10.0)] {
+        let scene = prismatic_room_with(&format!("sweep_{a}_{b}"), [a, b]);
+        let Run { code, out: read, err } =
+            heliodon(&[&["sensors", scene.to_str().unwrap(), "--format", "csv"][..], &at[..]].concat(), &scratch());
+        assert_eq!(code, 0, "{err}");
+        let key = [format!("{a}"), format!("{b}")];
+        let swept: Vec<&(Vec<String>, String, String)> = rows.iter().filter(|r| r.0 == key).collect();
+        assert_eq!(swept.len(), sensors);
+        for (line, row) in read.lines().skip(1).zip(swept) {
+            let (name, lux) = line.split_once(',').unwrap();
+            let expected: f64 = lux.split(',').next().unwrap().parse().unwrap();
+            let value: f64 = row.2.parse().unwrap();
+            assert_eq!(name, row.1);
+            assert!((value - expected).abs() <= 0.005 * expected + 0.05, "{key:?} {name}: sweep {value} vs sensors {expected}");
+        }
+    }
+    // Three shards, merged: the same bytes.
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sweep_shards");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut parts = Vec::new();
+    for k in 1..=3 {
+        let shard = format!("{k}/3");
+        let Run { code, out, err } = heliodon(&[&base[..], &at[..], &["--shard", &shard]].concat(), &scratch());
+        assert_eq!(code, 0, "{err}");
+        let part = dir.join(format!("part{k}.csv"));
+        std::fs::write(&part, out).unwrap();
+        parts.push(part.to_str().unwrap().to_string());
+    }
+    let merge: Vec<&str> = ["sweep-merge"].into_iter().chain(parts.iter().rev().map(String::as_str)).collect();
+    let Run { code, out: merged, err } = heliodon(&merge, &scratch());
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(merged, out);
+    // A part of another sweep, a missing part: one line each.
+    let other = dir.join("other.csv");
+    let Run { out: other_out, .. } =
+        heliodon(&[&base[..], &["--date", "2025-06-21", "--time", "11:00", "--shard", "1/3"]].concat(), &scratch());
+    std::fs::write(&other, other_out).unwrap();
+    for (files, expected) in
+        [(vec![other.to_str().unwrap(), &parts[1], &parts[2]], "of another sweep"), (vec![&parts[0], &parts[1]], "part 3/3 is missing")]
+    {
+        let Run { code, err, .. } = heliodon(&[&["sweep-merge"][..], &files[..]].concat(), &scratch());
+        assert_eq!(code, 1);
+        assert!(err.lines().count() == 1 && err.contains(expected), "{err}");
+    }
+}
+
+/// Over a year a sweep's DA300 and sDA are what `annual` gives for a scene
+/// file with those keys; the picture is written.
+#[test]
+fn sweeps_against_a_year_read_what_annual_reads() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sweep_year");
+    std::fs::create_dir_all(&dir).unwrap();
+    let epw = dir.join("boston.epw");
+    std::fs::write(&epw, boston_epw(8760)).unwrap();
+    let picture = dir.join("curve.png");
+    let room = bundled_scene("prismatic_room");
+    let args = ["sweep", room.to_str().unwrap(), "--material", "upper", "--vary", "facet_angles[0]=30..50:20", "--all-sensors"];
+    let Run { code, out, err } = heliodon(
+        &[&args[..], &["--weather", epw.to_str().unwrap(), "--format", "csv", "--out", picture.to_str().unwrap()]].concat(),
+        &scratch(),
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(out.starts_with("facet_angles[0],sensor,value\n"), "{out}");
+    let image = image::open(&picture).unwrap().to_rgb8();
+    assert!(image.pixels().any(|p| p.0 != [255, 255, 255]) && image.width() > 400);
+    let scene = prismatic_room_with("sweep_year_50", [50.0, 5.0]);
+    let Run { code, out: year, err } =
+        heliodon(&["annual", scene.to_str().unwrap(), "--weather", epw.to_str().unwrap(), "--format", "json"], &scratch());
+    assert_eq!(code, 0, "{err}");
+    let swept: Vec<(&str, f64)> = out
+        .lines()
+        .filter_map(|l| l.strip_prefix("50,"))
+        .map(|l| l.rsplit_once(',').map(|(s, v)| (s, v.parse().unwrap())).unwrap())
+        .collect();
+    for (sensor, value) in &swept {
+        let expected = if *sensor == "sDA300/50%" {
+            year.split("\"sda300_50\": ").nth(1).unwrap().split(',').next().unwrap().parse::<f64>().unwrap()
+        } else {
+            let at = year.find(&format!("\"name\": \"{sensor}\", \"da300\": ")).unwrap_or_else(|| panic!("{sensor} in {year}"));
+            year[at..].split("\"da300\": ").nth(1).unwrap().split(',').next().unwrap().parse().unwrap()
+        };
+        assert!((value - expected).abs() <= 0.05, "{sensor}: sweep {value} vs annual {expected}");
+    }
+    assert!(swept.iter().any(|s| s.0 == "sDA300/50%") && swept.len() > 5, "{out}");
+}
+
+#[test]
+fn sweeps_refuse_bad_input_in_one_line() {
+    let room = bundled_scene("prismatic_room");
+    let room = room.to_str().unwrap();
+    let at = ["--date", "2025-12-21", "--time", "11:00", "--all-sensors"];
+    let cases: [(&[&str], i32, &str); 10] = [
+        (&["--material", "curtain", "--vary", "facet_angles[0]=0..10:5"], 1, "--material curtain: no face of the model uses it"),
+        (&["--material", "wall", "--vary", "facet_angles[0]=0..10:5"], 1, "a diffuse material"),
+        (&["--material", "upper", "--vary", "tilt=0..10:5"], 1, "'tilt' is not a key of panel 'prismatic'"),
+        (&["--material", "upper", "--vary", "facet_angles[2]=0..10:5"], 1, "a list of 2 numbers"),
+        (&["--material", "upper", "--vary", "facet_angles[0]=a..10:5"], 2, "LO 'a' is not a number"),
+        (&["--material", "upper", "--vary", "facet_angles[0]=10..0:5"], 2, "the range is empty"),
+        (&["--material", "upper", "--vary", "facet_angles[0]=0..10:0"], 2, "the step must be positive"),
+        (
+            &[
+                "--material",
+                "upper",
+                "--vary",
+                "facet_angles[0]=0..10:5",
+                "--vary",
+                "facet_angles[1]=0..10:5",
+                "--vary",
+                "refractive_index=1.4..1.5:0.1",
+            ],
+            2,
+            "3 keys given",
+        ),
+        (&["--material", "upper", "--vary", "facet_angles[0]=0..10:5", "--shard", "0/4"], 2, "K must be from 1 to 4"),
+        (&["--material", "upper", "--vary", "facet_angles[0]=0..10:5", "--shard", "5/4"], 2, "K must be from 1 to 4"),
+    ];
+    for (flags, expected_code, expected) in cases {
+        let Run { code, err, .. } = heliodon(&[&["sweep", room][..], flags, &at[..]].concat(), &scratch());
+        assert_eq!(code, expected_code, "{flags:?}: {err}");
+        assert!(err.trim_end().lines().count() == 1 && err.contains(expected), "{flags:?}: {err}");
+    }
+}

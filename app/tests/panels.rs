@@ -174,7 +174,7 @@ fn sensor_coefficients_read_panel_rooms_as_a_solve_does() {
         let model = heliodon::light::LightModel::precompute(scene.clone(), quick()).unwrap();
         let sky = winter_noon(&scene);
         let solved = model.solve(&sky, None);
-        let read = model.sensor_coefficients().readings(&sky, None);
+        let read = model.sensor_coefficients().readings(&model, &sky, None);
         for (a, b) in solved.sensors.iter().zip(&read) {
             let close = |x: f64, y: f64, tolerance: f64| (x - y).abs() <= tolerance * x.abs().max(y.abs()) + 0.01;
             assert!(close(a.direct_sun, b.direct_sun, 1e-9) && close(a.direct_sky, b.direct_sky, 1e-9), "{name}: {a:?} vs {b:?}");

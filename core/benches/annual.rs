@@ -10,7 +10,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use heliodon_core::annual::{Occupancy, annual};
+use heliodon_core::annual::{AnnualOptions, annual};
 use heliodon_core::light::{LightModel, LightSettings};
 use heliodon_core::panel::PanelCatalog;
 use heliodon_core::scene::{Scene, load_scene};
@@ -33,7 +33,7 @@ fn scenes() -> Vec<(&'static str, Arc<Scene>)> {
 }
 
 fn year(model: &LightModel, weather: &Weather) -> f64 {
-    let result = annual(model, &model.scene.site, weather, Occupancy::default(), None, false, &|_| {}).unwrap();
+    let result = annual(model, &model.scene.site, weather, &AnnualOptions::default(), &|_| {}).unwrap();
     result.sda()
 }
 

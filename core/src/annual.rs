@@ -221,24 +221,44 @@ pub type ShadedModel<'a> = &'a (dyn Fn(&[usize]) -> Result<LightModel, String> +
 /// point sensors get [`ASE_LUX`] or more of direct sun through its windows.
 const SHADE_SENSOR_SHARE: f64 = 0.02;
 
-/// Runs the year. With `shades` (the scene's `[[shades]]`, LM-83), every
-/// occupied hour lowers the groups whose windows let too much direct sun
-/// onto the point sensors and reads DA and UDI with them down (ASE always
-/// with every shade up). `keep_hourly` keeps every hour's total lux (8,760
-/// × sensors values); `progress` hears the share of days done (from any
-/// thread). Fails only when a shaded model cannot be made.
+/// How a year is studied, beyond the model and the weather.
+#[derive(Clone, Copy, Default)]
+pub struct AnnualOptions<'a> {
+    /// The occupied hours of each day.
+    pub occupancy: Occupancy,
+    /// The scene's `[[shades]]` (LM-83), when studied: makes the models
+    /// with shades down.
+    pub shades: Option<ShadedModel<'a>>,
+    /// Keep every hour's total lux (8,760 × sensors values).
+    pub keep_hourly: bool,
+    /// The model's sensor coefficients, when the caller has them already
+    /// (a sweep of panel keys keeps one set for every combination).
+    pub coefficients: Option<&'a SensorCoefficients>,
+}
+
+/// Runs the year. With `options.shades`, every occupied hour lowers the
+/// groups whose windows let too much direct sun onto the point sensors and
+/// reads DA and UDI with them down (ASE always with every shade up).
+/// `progress` hears the share of days done (from any thread). Fails only
+/// when a shaded model cannot be made.
 pub fn annual(
     model: &LightModel,
     site: &Site,
     weather: &Weather,
-    occupancy: Occupancy,
-    shades: Option<ShadedModel>,
-    keep_hourly: bool,
+    options: &AnnualOptions,
     progress: &(dyn Fn(f64) + Sync),
 ) -> Result<AnnualResult, String> {
+    let AnnualOptions { occupancy, shades, keep_hourly, .. } = *options;
     let scene = &model.scene;
     let sensor_count = scene.sensors.len();
-    let coefficients = model.sensor_coefficients();
+    let own;
+    let coefficients = match options.coefficients {
+        Some(coefficients) => coefficients,
+        None => {
+            own = model.sensor_coefficients();
+            &own
+        }
+    };
     // Every hour's sky first: the sun paths are traced around the suns of the lit ones.
     let skies: Vec<Result<Option<Sky>, SkyError>> = par_map(None, HOURS, |k| {
         let hour = &weather.hours[k];
@@ -246,7 +266,7 @@ pub fn annual(
     });
     let lit = |k: usize| skies[k].as_ref().ok().and_then(Option::as_ref);
     let suns = |hours: &mut dyn Iterator<Item = usize>| -> Vec<DVec3> { hours.filter_map(|k| lit(k)?.sun).map(|s| s.direction).collect() };
-    let sun_path = SunPath::new(&coefficients, site, &suns(&mut (0..HOURS)), None);
+    let sun_path = SunPath::new(model, coefficients, site, &suns(&mut (0..HOURS)), None);
 
     // Which shade groups are down in each hour (a bit per group), and the
     // light with each combination that occurs.
@@ -266,12 +286,12 @@ pub fn annual(
             Ok((mask, shades.expect("shades are studied")(&lowered)?))
         })
         .collect::<Result<_, String>>()?;
-    let shaded: Vec<(u32, SensorCoefficients, SunPath)> = shaded_models
+    let shaded: Vec<(u32, &LightModel, SensorCoefficients, SunPath)> = shaded_models
         .iter()
         .map(|(mask, model)| {
             let coefficients = model.sensor_coefficients();
-            let path = SunPath::new(&coefficients, site, &suns(&mut (0..HOURS).filter(|&k| down[k] == *mask)), None);
-            (*mask, coefficients, path)
+            let path = SunPath::new(model, &coefficients, site, &suns(&mut (0..HOURS).filter(|&k| down[k] == *mask)), None);
+            (*mask, model, coefficients, path)
         })
         .collect();
 
@@ -289,10 +309,10 @@ pub fn annual(
             tally.skipped += usize::from(skies[k].is_err());
             // (total with the hour's shades, direct sun with every shade up) per sensor.
             let readings: Option<Vec<(f64, f64)>> = lit(k).map(|sky| {
-                let up = coefficients.readings_on_path(sky, &sun_path, Some(1));
+                let up = coefficients.readings_on_path(model, sky, &sun_path, Some(1));
                 match shaded.iter().find(|(mask, ..)| *mask == down[k]) {
-                    Some((_, coefficients, path)) => {
-                        let lowered = coefficients.readings_on_path(sky, path, Some(1));
+                    Some((_, model, coefficients, path)) => {
+                        let lowered = coefficients.readings_on_path(model, sky, path, Some(1));
                         lowered.iter().zip(&up).map(|(l, u)| (l.total, u.direct_sun)).collect()
                     }
                     None => up.iter().map(|r| (r.total, r.direct_sun)).collect(),

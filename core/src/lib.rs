@@ -31,6 +31,7 @@ pub mod site;
 pub mod sky;
 pub mod sun;
 pub mod sun_pass;
+pub mod sweep;
 pub mod time;
 pub mod weather;
 

@@ -527,7 +527,7 @@ fn sensor_coefficients_read_what_a_radiosity_solve_reads() {
     for (spec, date, time) in &skies {
         let sky = sky_at(&scene, spec, date, time);
         let solved = model.solve(&sky, None);
-        let read = coefficients.readings(&sky, None);
+        let read = coefficients.readings(&model, &sky, None);
         for (a, b) in solved.sensors.iter().zip(&read) {
             let close = |x: f64, y: f64, tolerance: f64| (x - y).abs() <= tolerance * x.abs().max(y.abs()) + 0.01;
             assert!(close(a.direct_sun, b.direct_sun, 1e-9) && close(a.direct_sky, b.direct_sky, 1e-9), "{date} {time}: {a:?} vs {b:?}");
@@ -536,7 +536,7 @@ fn sensor_coefficients_read_what_a_radiosity_solve_reads() {
         assert!(read.iter().any(|r| r.indirect > 10.0), "{date} {time}: a lit office");
     }
     let sky = sky_at(&scene, &skies[0].0, skies[0].1, skies[0].2);
-    assert_eq!(coefficients.readings(&sky, Some(1)), coefficients.readings(&sky, Some(3)));
+    assert_eq!(coefficients.readings(&model, &sky, Some(1)), coefficients.readings(&model, &sky, Some(3)));
 }
 
 /// A year's hours read through the sun path (the sun's later bounces
@@ -559,11 +559,11 @@ fn the_sun_path_reads_what_tracing_reads() {
         .collect();
     assert!(skies.len() > 30);
     let suns: Vec<_> = skies.iter().map(|sky| sky.sun.unwrap().direction).collect();
-    let path = SunPath::new(&coefficients, &scene.site, &suns, None);
+    let path = SunPath::new(&model, &coefficients, &scene.site, &suns, None);
     let mut errors = Vec::new();
     for sky in &skies {
-        let traced = coefficients.readings(sky, None);
-        for (a, b) in traced.iter().zip(coefficients.readings_on_path(sky, &path, None)) {
+        let traced = coefficients.readings(&model, sky, None);
+        for (a, b) in traced.iter().zip(coefficients.readings_on_path(&model, sky, &path, None)) {
             assert_eq!((a.direct_sun, a.direct_sky), (b.direct_sun, b.direct_sky), "the direct light is never interpolated");
             errors.push((b.total - a.total).abs() / a.total);
         }

@@ -9,6 +9,7 @@
 
 pub mod args;
 pub mod commands;
+pub mod plot;
 
 use std::fmt;
 use std::path::PathBuf;
@@ -22,6 +23,7 @@ use commands::export_radiance::ExportArgs;
 use commands::render::RenderArgs;
 use commands::sensors::SensorsArgs;
 use commands::sun::SunArgs;
+use commands::sweep::{MergeArgs, SweepArgs};
 use commands::view::ViewArgs;
 
 #[derive(Parser, Debug)]
@@ -63,6 +65,12 @@ pub enum Command {
     Sun(SunArgs),
     /// A year of EPW weather at the sensors: DA300, UDI and ASE hours per sensor, the scene's sDA and ASE
     Annual(AnnualArgs),
+    /// Vary one or two keys of a window material over a grid: the sensors' lux at an instant, or DA300 and sDA over a year
+    #[command(allow_negative_numbers = true)]
+    Sweep(SweepArgs),
+    /// Join the CSV parts of a sharded sweep into the unsharded output
+    #[command(name = "sweep-merge")]
+    SweepMerge(MergeArgs),
 }
 
 /// Why a command failed: one line for standard error, and the exit code
@@ -131,6 +139,8 @@ pub fn main(panels: PanelCatalog) -> ExitCode {
         Some(Command::ExportRadiance(args)) => done(commands::export_radiance::run(&args, &panels)),
         Some(Command::Render(args)) => done(commands::render::run(&args, &panels)),
         Some(Command::Annual(args)) => done(commands::annual::run(&args, &panels)),
+        Some(Command::Sweep(args)) => done(commands::sweep::run(&args, &panels)),
+        Some(Command::SweepMerge(args)) => done(commands::sweep::merge(&args)),
         Some(Command::Sun(args)) => {
             commands::sun::run(&args);
             Ok(ExitCode::SUCCESS)

@@ -43,9 +43,13 @@ use crate::sky::{LUMINOUS_EFFICACY, Sky, SunSource};
 /// Sensors whose adjoints are iterated together.
 const BLOCK: usize = 32;
 
-/// Each sensor's interreflected light per unit of every source, for one model.
-pub struct SensorCoefficients<'a> {
-    model: &'a LightModel,
+/// Each sensor's interreflected light per unit of every source, for one
+/// model. They hold for the model they were made from and for any that
+/// differs from it only in panel models ([`LightModel::set_panel_model`]:
+/// panels change what the sky and sun send through the windows, not how
+/// the room passes it on), which is what sweeps of panel keys rely on.
+pub struct SensorCoefficients {
+    sensors: usize,
     slots: RadianceSlots,
     /// Interreflected lux per unit radiance (W/m²/sr) of each slot, `[slot][sensor]`.
     sky: Vec<f32>,
@@ -61,7 +65,7 @@ pub struct SensorCoefficients<'a> {
 
 impl LightModel {
     /// Solves every sensor's adjoint and folds it into coefficients.
-    pub fn sensor_coefficients(&self) -> SensorCoefficients<'_> {
+    pub fn sensor_coefficients(&self) -> SensorCoefficients {
         let sensors = self.sensors.len();
         let sides = self.side_gathers.len();
         let slots = self.radiance_slots();
@@ -101,7 +105,7 @@ impl LightModel {
                 }
             }
         }
-        SensorCoefficients { model: self, slots, sky, sun, seen, iterations }
+        SensorCoefficients { sensors, slots, sky, sun, seen, iterations }
     }
 
     /// Column lists of the form factors: for side j, every (i, F_ij).
@@ -188,19 +192,19 @@ impl LightModel {
     }
 }
 
-impl SensorCoefficients<'_> {
+impl SensorCoefficients {
     /// Every sensor's reading under `sky` (`threads` as [`par_map`]): equal
     /// to [`LightModel::solve`]'s up to its tolerance.
-    pub fn readings(&self, sky: &Sky, threads: Option<usize>) -> Vec<SensorReading> {
-        self.read(sky, threads, |beams| self.interreflected_sun(beams, threads))
+    pub fn readings(&self, model: &LightModel, sky: &Sky, threads: Option<usize>) -> Vec<SensorReading> {
+        self.read(model, sky, threads, |beams| self.interreflected_sun(model, beams, threads))
     }
 
     /// [`Self::readings`] with the sun's light beyond its first bounce read
     /// from a [`SunPath`] instead of traced; the direct sun and its first
     /// bounce where the sensors' rays land are still traced.
-    pub fn readings_on_path(&self, sky: &Sky, path: &SunPath, threads: Option<usize>) -> Vec<SensorReading> {
-        self.read(sky, threads, |beams| {
-            let mut lux = self.first_bounce(beams, &self.model.sides_reach(beams, Some(&self.seen), threads), threads);
+    pub fn readings_on_path(&self, model: &LightModel, sky: &Sky, path: &SunPath, threads: Option<usize>) -> Vec<SensorReading> {
+        self.read(model, sky, threads, |beams| {
+            let mut lux = self.first_bounce(model, beams, &model.sides_reach(beams, Some(&self.seen), threads), threads);
             if let Some(sun) = sky.sun.filter(|s| s.direction.z > 0.0) {
                 for (e, later) in lux.iter_mut().zip(path.later_bounces(sun.direction)) {
                     *e += sun.normal_irradiance() * later;
@@ -212,8 +216,13 @@ impl SensorCoefficients<'_> {
 
     /// The readings, with the sun's interreflected light (lux per sensor)
     /// from `interreflected_sun` of the sky's beams.
-    fn read(&self, sky: &Sky, threads: Option<usize>, interreflected_sun: impl FnOnce(&[SunBeam]) -> Vec<f64>) -> Vec<SensorReading> {
-        let model = self.model;
+    fn read(
+        &self,
+        model: &LightModel,
+        sky: &Sky,
+        threads: Option<usize>,
+        interreflected_sun: impl FnOnce(&[SunBeam]) -> Vec<f64>,
+    ) -> Vec<SensorReading> {
         let count = model.sensors.len();
         let seen = model.key_radiance(sky);
         let beams = sky.sun.filter(|s| s.direction.z > 0.0).map(|s| model.sun_beams(&s)).unwrap_or_default();
@@ -237,22 +246,22 @@ impl SensorCoefficients<'_> {
 
     /// The beams' interreflected light at every sensor, lux: traced on the
     /// sides some sensor sees and where the sensors' rays land.
-    fn interreflected_sun(&self, beams: &[SunBeam], threads: Option<usize>) -> Vec<f64> {
-        let sides_sun = self.model.sun_on_sides(beams, Some(&self.seen), threads);
-        let mut lux = self.first_bounce(beams, &sides_sun.reach, threads);
+    fn interreflected_sun(&self, model: &LightModel, beams: &[SunBeam], threads: Option<usize>) -> Vec<f64> {
+        let sides_sun = model.sun_on_sides(beams, Some(&self.seen), threads);
+        let mut lux = self.first_bounce(model, beams, &sides_sun.reach, threads);
         add_products(&mut lux, self.later_bounces(&sides_sun.irradiance));
         lux
     }
 
     /// The beams' first bounce where each sensor's rays land, lux.
-    fn first_bounce(&self, beams: &[SunBeam], reach: &[Reach], threads: Option<usize>) -> Vec<f64> {
-        par_map(threads, self.model.sensors.len(), |i| luminous(self.model.sensor_sun_bounce(i, beams, reach)) * LUMINOUS_EFFICACY)
+    fn first_bounce(&self, model: &LightModel, beams: &[SunBeam], reach: &[Reach], threads: Option<usize>) -> Vec<f64> {
+        par_map(threads, model.sensors.len(), |i| luminous(model.sensor_sun_bounce(i, beams, reach)) * LUMINOUS_EFFICACY)
     }
 
     /// The terms of the beams' later bounces: each side's beam irradiance
     /// with its row of coefficients.
     fn later_bounces<'s>(&'s self, beams_on_sides: &'s [f64]) -> impl Iterator<Item = (&'s f64, &'s [f32])> {
-        beams_on_sides.iter().zip(self.sun.chunks_exact(self.model.sensors.len().max(1)))
+        beams_on_sides.iter().zip(self.sun.chunks_exact(self.sensors.max(1)))
     }
 }
 
@@ -290,7 +299,7 @@ pub const SUN_PATH_STEP: f64 = 2.5;
 impl SunPath {
     /// Traces the nodes around every sun direction in `suns` (directions in
     /// the model's frame, as the site's skies give them).
-    pub fn new(coefficients: &SensorCoefficients, site: &Site, suns: &[DVec3], threads: Option<usize>) -> Self {
+    pub fn new(model: &LightModel, coefficients: &SensorCoefficients, site: &Site, suns: &[DVec3], threads: Option<usize>) -> Self {
         let latitude = site.latitude.to_radians();
         let mut path = Self { latitude: latitude.sin_cos(), north_turn: site.north_turn.to_radians(), nodes: Default::default() };
         let mut needed: Vec<(i32, i32)> =
@@ -299,12 +308,9 @@ impl SunPath {
         let values = par_map(threads, needed.len(), |k| {
             let direction = path.direction(needed[k]);
             let sun = SunSource { direction, solid_angle: 1.0, radiance: 1.0 };
-            let beams = coefficients.model.sun_beams(&sun);
-            let mut lux = vec![0.0; coefficients.model.sensors.len()];
-            add_products(
-                &mut lux,
-                coefficients.later_bounces(&coefficients.model.sun_on_sides(&beams, Some(&coefficients.seen), Some(1)).irradiance),
-            );
+            let beams = model.sun_beams(&sun);
+            let mut lux = vec![0.0; model.sensors.len()];
+            add_products(&mut lux, coefficients.later_bounces(&model.sun_on_sides(&beams, Some(&coefficients.seen), Some(1)).irradiance));
             lux
         });
         path.nodes = needed.into_iter().zip(values).collect();

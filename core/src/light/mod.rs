@@ -265,6 +265,17 @@ impl LightModel {
         2 * self.sky_bins.len() as u32
     }
 
+    /// Puts `model` in the windows of panel material `material` (an index
+    /// into [`Scene::materials`]): what the sky and sun send through them
+    /// changes, the gathered transport does not (rays pass panels
+    /// unweighted), so a sweep of panel keys keeps one precomputation.
+    /// `scene.materials` keeps the file's keys.
+    pub fn set_panel_model(&mut self, material: u32, model: Arc<dyn crate::panel::PanelModel>) {
+        for group in self.panel_groups.iter_mut().filter(|g| g.material == material) {
+            group.set_model(model.clone());
+        }
+    }
+
     /// Which panel group a surface's windows belong to.
     pub fn panel_group_of_surface(&self, surface: u32) -> Option<u32> {
         self.group_of_surface[surface as usize]

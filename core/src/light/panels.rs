@@ -72,6 +72,12 @@ pub struct SkyTransfer {
 }
 
 impl PanelGroup {
+    /// Another model for the group's windows; its sky transfer is made anew.
+    pub fn set_model(&mut self, model: Arc<dyn PanelModel>) {
+        self.model = model;
+        self.transfer = OnceLock::new();
+    }
+
     /// The group's sky transfer over `bins`' sphere bins.
     pub fn sky_transfer(&self, bins: &SkyPatches) -> &SkyTransfer {
         self.transfer.get_or_init(|| {

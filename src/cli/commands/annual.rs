@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use crate::annual::{AnnualResult, Occupancy, ShadedModel, annual, hour_time};
+use crate::annual::{AnnualOptions, AnnualResult, Occupancy, ShadedModel, annual, hour_time};
 use crate::cli::CliError;
 use crate::cli::args::{Format, load_for_command, precompute_for_command, progress_bar};
 use crate::panel::PanelCatalog;
@@ -77,8 +77,8 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     let shaded = |down: &[usize]| precompute_for_command(std::sync::Arc::new(scene.with_shades_down(down)), args.no_cache);
     let shades: Option<ShadedModel> = (!scene.shades.is_empty() && !args.no_shades).then_some(&shaded);
     let progress = progress_bar("a year of hours");
-    let result =
-        annual(&model, site, &weather, args.occupied, shades, args.hourly.is_some(), &|done| progress.set_position((done * 1000.0) as u64));
+    let options = AnnualOptions { occupancy: args.occupied, shades, keep_hourly: args.hourly.is_some(), coefficients: None };
+    let result = annual(&model, site, &weather, &options, &|done| progress.set_position((done * 1000.0) as u64));
     progress.finish_and_clear();
     let result = result?;
     if result.skipped_hours > 0 {

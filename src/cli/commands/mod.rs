@@ -8,4 +8,5 @@ pub mod info;
 pub mod render;
 pub mod sensors;
 pub mod sun;
+pub mod sweep;
 pub mod view;
