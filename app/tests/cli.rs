@@ -136,7 +136,11 @@ fn help_lists_only_what_exists() {
         .take_while(|l| l.starts_with("  "))
         .filter_map(|l| l.split_whitespace().next())
         .collect();
-    assert_eq!(commands, ["view", "info", "sensors", "export-radiance", "render", "sun", "annual", "help"], "{out}");
+    assert_eq!(
+        commands,
+        ["view", "info", "sensors", "export-radiance", "render", "sun", "annual", "sweep", "sweep-merge", "help"],
+        "{out}"
+    );
 }
 
 // ---- sun -------------------------------------------------------------------------
