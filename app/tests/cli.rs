@@ -5,6 +5,8 @@
 
 #[path = "../../tests/support/cli.rs"]
 mod cli;
+#[path = "../../tests/support/epw.rs"]
+mod epw;
 #[path = "../../tests/support/fixture.rs"]
 mod fixture;
 
@@ -20,6 +22,7 @@ use heliodon_core::sun::solar_position;
 use heliodon_core::time::{Date, LocalDateTime, TimeOfDay};
 
 use cli::{Run, heliodon, root};
+use epw::boston_epw;
 use fixture::{OBJ, fixture, scene_toml};
 
 /// A light cache for the commands whose caching is not what is tested.
@@ -378,33 +381,6 @@ fn export_radiance_writes_the_same_model_and_sky() {
 }
 
 // ---- annual ----------------------------------------------------------------------
-
-/// An EPW at Boston (the bundled scenes' site): dark except the 21st of
-/// March, June, September and December, whose hours get a day of
-/// irradiance; `rows` data rows.
-fn boston_epw(rows: usize) -> String {
-    let mut text = String::from("LOCATION,Boston Logan,MA,USA,TMY3,725090,42.37,-71.01,-5.0,6.0\n");
-    for header in ["DESIGN CONDITIONS,0", "TYPICAL/EXTREME PERIODS,0", "GROUND TEMPERATURES,0", "HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0"] {
-        text += header;
-        text.push('\n');
-    }
-    text += "COMMENTS 1,synthetic\nCOMMENTS 2,\nDATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n";
-    let mut index = 0;
-    for month in 1..=12u32 {
-        for day in 1..=heliodon_core::time::days_in_month(2025, month) {
-            for hour in 1..=24u32 {
-                if index == rows {
-                    return text;
-                }
-                index += 1;
-                let lit = day == 21 && month % 3 == 0 && (6..=20).contains(&hour);
-                let (dni, dhi) = if lit { (60.0 * (hour as f64 - 5.0), 40.0 + 10.0 * (hour % 4) as f64) } else { (0.0, 0.0) };
-                text += &format!("2025,{month},{day},{hour},60,?9?9?9?9E0,10,5,70,101000,0,0,300,0,{dni},{dhi},0,0,0,0,0,0,0,0,0\n");
-            }
-        }
-    }
-    text
-}
 
 /// `annual` on the test room: every hour of `--hourly` is `sensors --sky
 /// perez` at the hour's middle, and DA300 and UDI are the shares of the

@@ -3,6 +3,9 @@
 //! for the light and the sensor's day, saves the window with its panels and
 //! the 3D view's luminance, and exits.
 
+#[path = "../../tests/support/epw.rs"]
+mod epw;
+
 use std::path::Path;
 use std::process::Command;
 
@@ -82,4 +85,52 @@ fn read_hdr(path: &Path) -> (usize, usize, Vec<[f32; 3]>) {
     let pixels: Vec<[f32; 3]> = image.pixels().map(|p| p.0).collect();
     assert_eq!(pixels.len(), width * height, "{}", path.display());
     (width, height, pixels)
+}
+
+/// `view --weather FILE --annual --screenshot`: the sky of the shown hour
+/// comes from the weather file, the year runs in the background and is
+/// waited for, and its sDA and ASE are those of `heliodon annual`.
+#[test]
+fn the_viewer_runs_the_year_of_a_weather_file() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viewer_annual");
+    std::fs::create_dir_all(&dir).unwrap();
+    let epw = dir.join("boston.epw");
+    std::fs::write(&epw, epw::boston_epw(8760)).unwrap();
+    let shot = dir.join("annual.png");
+    let _ = std::fs::remove_file(&shot);
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes/test_room/scene.toml");
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1280x800x24", env!("CARGO_BIN_EXE_heliodon"), "view"])
+        .arg(&scene)
+        .args(["--date", "2026-03-21", "--time", "10:30", "--weather"])
+        .arg(&epw)
+        .args(["--annual", "--screenshot"])
+        .arg(&shot)
+        .env("HELIODON_CACHE_DIR", dir.join("cache"))
+        .output()
+        .expect("xvfb-run (tools/system-deps installs it)");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let said = String::from_utf8_lossy(&out.stdout);
+    let annual = Command::new(env!("CARGO_BIN_EXE_heliodon"))
+        .arg("annual")
+        .arg(&scene)
+        .arg("--weather")
+        .arg(&epw)
+        .args(["--format", "json"])
+        .env("HELIODON_CACHE_DIR", dir.join("cache"))
+        .output()
+        .unwrap();
+    let json = String::from_utf8_lossy(&annual.stdout);
+    let field = |key: &str| json.split(&format!("\"{key}\": ")).nth(1).unwrap().split(',').next().unwrap().to_string();
+    let expected =
+        format!("sDA300/50% {}%, ASE1000/250 {}%, {} occupied hours", field("sda300_50"), field("ase1000_250"), field("occupied_hours"));
+    assert!(said.contains(&expected), "viewer said '{said}', annual '{expected}'");
+    // 21 March 10:30 is a lit hour of the weather file: the model is lit.
+    let image = image::open(&shot).expect("the screenshot").to_rgb8();
+    let lit = (400..880)
+        .step_by(8)
+        .flat_map(|x| (100..700).step_by(8).map(move |y| (x, y)))
+        .filter(|&(x, y)| image.get_pixel(x, y).0.iter().map(|&c| u32::from(c)).sum::<u32>() > 150)
+        .count();
+    assert!(lit > 1000, "{lit} lit pixels of the view");
 }

@@ -135,6 +135,23 @@ impl AnnualResult {
         self.share(|s| s.ase_hours >= ASE_HOURS)
     }
 
+    /// The per-sensor table as `annual --format csv` prints it.
+    pub fn csv(&self) -> String {
+        let mut out = String::from("name,da300,udi_low,udi,udi_high,ase_hours\n");
+        for s in &self.sensors {
+            out += &format!(
+                "{},{:.1},{:.1},{:.1},{:.1},{}\n",
+                crate::report::csv_field(&s.name),
+                s.da300,
+                s.udi_low,
+                s.udi,
+                s.udi_high,
+                s.ase_hours
+            );
+        }
+        out
+    }
+
     fn share(&self, counts: impl Fn(&SensorYear) -> bool) -> f64 {
         let points: Vec<&SensorYear> = self.sensors.iter().filter(|s| s.point).collect();
         if points.is_empty() {

@@ -1,5 +1,6 @@
 //! The viewer as a batch job (`heliodon view SCENE --screenshot FILE`,
-//! `--hdr FILE`, `--sensor NAME [--year]`, `--date`, `--time`, `--sky`):
+//! `--hdr FILE`, `--sensor NAME [--year]`, `--date`, `--time`, `--sky`,
+//! `--weather FILE [--annual]`):
 //! start at the given time and sky, select the sensor, wait until the light
 //! has converged (and the sensor's plots are in), save, and exit.
 
@@ -7,6 +8,7 @@ use std::path::PathBuf;
 
 use bevy::prelude::*;
 
+use super::annual::{AnnualStudy, Metric};
 use super::capture::{SaveResults, SaveView};
 use super::sensors::{DaySeries, SelectedSensor, YearMap};
 use crate::ecs::{ActiveScene, HeliodonSystems, LightingState, SceneSpawned, SkyChoice, SolarTime};
@@ -36,15 +38,35 @@ pub struct ViewStart {
     pub year: bool,
     pub when: Option<crate::time::LocalDateTime>,
     pub sky: Option<crate::sky::SkySpec>,
+    /// A weather file to open (its hour's sky drives the view).
+    pub weather: Option<PathBuf>,
+    /// Run the year at once (and wait for it before saving).
+    pub annual: bool,
 }
 
-fn apply_view_start(request: Option<Res<ViewStart>>, mut time: ResMut<SolarTime>, mut sky: ResMut<SkyChoice>) {
+fn apply_view_start(
+    request: Option<Res<ViewStart>>,
+    mut time: ResMut<SolarTime>,
+    mut sky: ResMut<SkyChoice>,
+    mut study: ResMut<AnnualStudy>,
+    mut exit: MessageWriter<AppExit>,
+) {
     let Some(request) = request else { return };
     if let Some(when) = request.when {
         time.0 = when;
     }
     if let Some(spec) = request.sky.clone() {
         sky.0 = spec;
+    }
+    if let Some(path) = &request.weather {
+        if let Err(e) = study.open(path) {
+            eprintln!("error: --weather {e}");
+            exit.write(AppExit::error());
+        }
+        study.requested = request.annual;
+        if request.annual {
+            study.colour_by = Some(Metric::Da300);
+        }
     }
 }
 
@@ -94,6 +116,7 @@ fn take_screenshot(
     selected: Res<SelectedSensor>,
     day: Res<DaySeries>,
     year: Res<YearMap>,
+    study: Res<AnnualStudy>,
     results: Res<SaveResults>,
     mut saves: MessageWriter<SaveView>,
     mut frames: Local<u32>,
@@ -108,9 +131,17 @@ fn take_screenshot(
     if *frames < SETTLE_FRAMES {
         // The light has converged, and the selected sensor's day (and year) are in.
         let plots_in = selected.0.is_none() || (day.0.values.is_some() && (!request.year || year.map.values.is_some()));
-        *frames = if lighting.is_some_and(|l| l.converged) && plots_in { *frames + 1 } else { 0 };
+        let year_in = !request.annual || study.result.values.is_some();
+        *frames = if lighting.is_some_and(|l| l.converged) && plots_in && year_in { *frames + 1 } else { 0 };
         if *frames == SETTLE_FRAMES {
             saves.write_batch(wanted);
+            match &study.result.values {
+                Some(Ok(year)) => {
+                    println!("sDA300/50% {:.1}%, ASE1000/250 {:.1}%, {} occupied hours", year.sda(), year.ase(), year.occupied_hours)
+                }
+                Some(Err(e)) => eprintln!("error: the year: {e}"),
+                None => {}
+            }
         }
         return;
     }

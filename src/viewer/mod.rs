@@ -5,14 +5,18 @@
 //!   number widgets and their note ([`widgets`]) and who has the pointer
 //!   ([`focus`]),
 //! - sensors: markers, picking, a sensor's day and year ([`sensors`]),
+//! - the annual study: a weather file, its hour's sky, the year in the
+//!   background and the sensors coloured by a metric ([`annual`]),
 //! - panel lobes ([`lobes`]), saving the view ([`capture`]),
 //! - the batch flow of `view --screenshot/--hdr/--sensor` ([`batch`]).
 //!
 //! The modules form a one-way graph: `schedule` (the system sets),
-//! `focus` and `widgets` are leaves;
-//! `camera`, `capture`, `sensors` and `lobes` read them; `ui` reads
-//! everything and nothing imports `ui`.
+//! `focus`, `widgets` and `background` are leaves;
+//! `camera`, `capture`, `sensors`, `annual` and `lobes` read them; `ui`
+//! and `batch` read everything and nothing imports `ui`.
 
+pub mod annual;
+pub mod background;
 pub mod batch;
 pub mod camera;
 pub mod capture;
@@ -78,6 +82,7 @@ impl Plugin for ViewerPlugin {
             camera::CameraPlugin,
             capture::CapturePlugin,
             sensors::SensorsPlugin,
+            annual::AnnualPlugin,
             lobes::LobesPlugin,
             batch::BatchPlugin,
         ));

@@ -9,8 +9,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
-use bevy::tasks::{AsyncComputeTaskPool, Task, block_on, futures_lite::future};
 
+use super::background::Background;
 use super::camera::cursor_in_view;
 use super::focus::PanelFocus;
 use super::schedule::ViewerSystems;
@@ -37,40 +37,6 @@ impl Plugin for SensorsPlugin {
 /// The sensor the panels and the plot follow.
 #[derive(Resource, Debug, Default, Clone, Copy, PartialEq, Eq)]
 pub struct SelectedSensor(pub Option<usize>);
-
-/// A result computed in the background for a key (what it was asked for).
-pub struct Background<K, T> {
-    key: Option<K>,
-    task: Option<Task<T>>,
-    /// The result, once done; `None` while computing or when not asked.
-    pub values: Option<T>,
-}
-
-impl<K, T> Default for Background<K, T> {
-    fn default() -> Self {
-        Self { key: None, task: None, values: None }
-    }
-}
-
-impl<K: PartialEq, T: Send + 'static> Background<K, T> {
-    /// Takes the result if the task has finished.
-    fn collect(&mut self) {
-        if let Some(task) = &mut self.task
-            && let Some(values) = block_on(future::poll_once(task))
-        {
-            self.values = Some(values);
-            self.task = None;
-        }
-    }
-
-    /// Starts `work` for `key` on the async compute pool, in place of
-    /// whatever was there.
-    fn start(&mut self, key: Option<K>, work: impl FnOnce() -> T + Send + 'static) {
-        self.key = key;
-        self.values = None;
-        self.task = Some(AsyncComputeTaskPool::get().spawn(async move { work() }));
-    }
-}
 
 /// The selected sensor's total illuminance (lux) over the day, by half
 /// hour from 00:15; keyed by sensor, date, sky, site and light model (a new

@@ -111,13 +111,7 @@ fn hourly_csv(result: &AnnualResult, weather: &Weather) -> String {
 fn report(result: &AnnualResult, format: Format, weather_path: &std::path::Path) -> String {
     let mut out = String::new();
     match format {
-        Format::Csv => {
-            out.push_str("name,da300,udi_low,udi,udi_high,ase_hours\n");
-            for s in &result.sensors {
-                let _ =
-                    writeln!(out, "{},{:.1},{:.1},{:.1},{:.1},{}", csv_field(&s.name), s.da300, s.udi_low, s.udi, s.udi_high, s.ase_hours);
-            }
-        }
+        Format::Csv => out.push_str(&result.csv()),
         Format::Json => {
             let rows: Vec<String> = result
                 .sensors

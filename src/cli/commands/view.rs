@@ -33,6 +33,12 @@ pub struct ViewArgs {
     pub time: Option<TimeOfDay>,
     #[command(flatten)]
     pub sky: SkyArgs,
+    /// A weather file (EPW): the sky of the shown hour comes from it, and the annual panel can run the year
+    #[arg(long, value_name = "FILE.epw")]
+    pub weather: Option<PathBuf>,
+    /// With --weather: run the year at once, colour the sensors by DA300 (and, with --screenshot, wait for it and print sDA and ASE)
+    #[arg(long, requires = "weather")]
+    pub annual: bool,
 }
 
 /// Opens the viewer on `scene` (the bundled office when none).
@@ -54,5 +60,7 @@ fn view_request(args: &ViewArgs) -> Result<crate::viewer::ViewStart, String> {
         year: args.year,
         when,
         sky,
+        weather: args.weather.clone(),
+        annual: args.annual,
     })
 }

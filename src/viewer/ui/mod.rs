@@ -4,13 +4,16 @@
 //! then the windows and materials ([`materials`]). Right: the camera
 //! ([`camera`]: presets, viewpoints, walk mode), the view ([`view`]: modes,
 //! the light's progress, saving the image) and the sensors ([`sensors`]:
-//! live table, the selected one's day and year, CSV export). The 3D view
+//! live table, the selected one's day and year, CSV export) and the annual
+//! study ([`annual`]: a weather file, its sky, the year, sensors coloured by
+//! DA300, UDI or ASE, CSV). The 3D view
 //! fills the space between them: the camera's viewport follows the panels,
 //! and the pointer over a panel belongs to the panel ([`PanelFocus`]).
 //!
 //! Panels only read state and write requests or resources; the systems
 //! that act on them live with what they act on (camera, capture, sensors).
 
+pub mod annual;
 pub mod camera;
 pub mod materials;
 pub mod sensors;
@@ -31,6 +34,7 @@ use super::focus::PanelFocus;
 use super::widgets::Note;
 use crate::render::{PictureCamera, RenderSettings};
 use crate::viewer::schedule::ViewerSystems;
+use annual::AnnualPanel;
 use materials::{MaterialEdits, MaterialPanel};
 use sensors::SensorPanel;
 use sun_and_sky::{PlayDay, SunAndSkyPanel};
@@ -81,6 +85,7 @@ fn panels(
     mut materials: MaterialPanel,
     mut view: ViewPanel,
     mut sensors: SensorPanel,
+    mut annual: AnnualPanel,
     window: Single<&Window, With<PrimaryWindow>>,
     mut cameras: Query<&mut Camera, PictureCamera>,
 ) -> Result {
@@ -91,6 +96,9 @@ fn panels(
         .show(&mut root, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
                 sun_and_sky.show(ui, &mut settings, &mut note.0);
+                if let Some(hour) = annual.sky_hour() {
+                    ui.label(egui::RichText::new(hour).color(egui::Color32::from_rgb(255, 210, 40)));
+                }
                 ui.separator();
                 materials.show(ui, &mut note.0, sun_and_sky.north_turn());
             });
@@ -105,6 +113,8 @@ fn panels(
                 camera::camera_panel(ui, &mut camera_control, &sensors.active);
                 ui.separator();
                 view.show(ui, &mut settings, &mut note.0);
+                ui.separator();
+                annual.show(ui, &mut note.0, sun_and_sky.site());
                 ui.separator();
                 sensors.show(ui, &mut note.0, sun_and_sky.now());
             });

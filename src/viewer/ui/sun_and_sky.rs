@@ -54,6 +54,11 @@ impl SunAndSkyPanel<'_> {
         self.site.as_ref().map_or(0.0, |s| s.north_turn)
     }
 
+    /// The site, once a scene has one.
+    pub fn site(&self) -> Option<crate::site::Site> {
+        self.site.as_ref().map(|s| s.0)
+    }
+
     /// The local date and time shown.
     pub fn now(&self) -> LocalDateTime {
         self.solar.0

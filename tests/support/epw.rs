@@ -1,0 +1,28 @@
+//! A synthetic EPW year for the annual tests: Boston's station, sun only
+//! on the 21st of March, June, September and December (06:00-20:00, DNI
+//! rising through the day), every other hour dark, so that a year is quick.
+
+/// The file's text with its first `rows` hours (8,760 for a whole year).
+pub fn boston_epw(rows: usize) -> String {
+    let mut text = String::from("LOCATION,Boston Logan,MA,USA,TMY3,725090,42.37,-71.01,-5.0,6.0\n");
+    for header in ["DESIGN CONDITIONS,0", "TYPICAL/EXTREME PERIODS,0", "GROUND TEMPERATURES,0", "HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0"] {
+        text += header;
+        text.push('\n');
+    }
+    text += "COMMENTS 1,synthetic\nCOMMENTS 2,\nDATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n";
+    let mut index = 0;
+    for month in 1..=12u32 {
+        for day in 1..=heliodon_core::time::days_in_month(2025, month) {
+            for hour in 1..=24u32 {
+                if index == rows {
+                    return text;
+                }
+                index += 1;
+                let lit = day == 21 && month % 3 == 0 && (6..=20).contains(&hour);
+                let (dni, dhi) = if lit { (60.0 * (hour as f64 - 5.0), 40.0 + 10.0 * (hour % 4) as f64) } else { (0.0, 0.0) };
+                text += &format!("2025,{month},{day},{hour},60,?9?9?9?9E0,10,5,70,101000,0,0,300,0,{dni},{dhi},0,0,0,0,0,0,0,0,0\n");
+            }
+        }
+    }
+    text
+}
