@@ -488,3 +488,50 @@ fn camera_requests_move_the_camera_and_save_views() {
     let back = *app.world().get::<CadCamera>(camera).unwrap();
     assert!((back.eye() - top.eye()).length() < 1e-3);
 }
+
+/// The viewer's sweep, as its panel starts it: the cells fill in from the
+/// background (more glass transmittance, more light at the sensor, about in
+/// proportion), and a clicked cell's keys become the material's.
+#[test]
+fn the_viewer_sweep_fills_in_and_applies_a_clicked_cell() {
+    use heliodon::ecs::ActiveScene;
+    use heliodon::scene::MaterialKind;
+    use heliodon::viewer::annual::AnnualStudy;
+    use heliodon::viewer::sensors::SelectedSensor;
+    use heliodon::viewer::sweep::{KeyRange, SweepPlugin, SweepStudy};
+
+    let mut app = lit_app("test_room");
+    app.init_resource::<SelectedSensor>().init_resource::<AnnualStudy>().add_plugins(SweepPlugin);
+    run_until_settled(&mut app, |_| {});
+    let scene = app.world().resource::<ActiveScene>().scene.clone().unwrap();
+    let glass = scene.materials.iter().position(|m| matches!(m.kind, MaterialKind::Glass { .. })).unwrap() as u32;
+    app.world_mut().resource_mut::<SelectedSensor>().0 = scene.sensors.iter().position(|s| s.name == "room-centre");
+    {
+        let mut study = app.world_mut().resource_mut::<SweepStudy>();
+        study.material = Some(glass);
+        study.ranges = vec![KeyRange { key: "transmittance".into(), lo: 0.3, hi: 0.6, step: 0.3 }];
+        study.requested = true;
+    }
+    let deadline = Instant::now() + Duration::from_secs(120);
+    loop {
+        app.update();
+        let study = app.world().resource::<SweepStudy>();
+        assert!(study.error.is_none(), "{:?}", study.error);
+        if !study.is_running() && study.progress() == (2, 2) {
+            break;
+        }
+        assert!(Instant::now() < deadline, "the sweep did not finish");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let cells: Vec<f64> =
+        app.world().resource::<SweepStudy>().cells.lock().unwrap().iter().map(|c| *c.as_ref().unwrap().as_ref().unwrap()).collect();
+    assert!(cells[0] > 20.0 && cells[1] > 1.6 * cells[0] && cells[1] < 2.4 * cells[0], "{cells:?}");
+    app.world_mut().resource_mut::<SweepStudy>().apply = Some(0);
+    // The click becomes an edit, the edit a new scene, the scene new light.
+    for _ in 0..3 {
+        app.update();
+    }
+    run_until_settled(&mut app, |_| {});
+    let scene = app.world().resource::<ActiveScene>().scene.clone().unwrap();
+    assert_eq!(scene.materials[glass as usize].kind, MaterialKind::Glass { transmittance: 0.3 });
+}

@@ -263,8 +263,9 @@ pub struct Outcome {
 }
 
 /// Runs combinations `range` of `grid` on `model` (precomputed for the
-/// scene as its file says), reading `sensors` (indices). `progress` hears
-/// the share done.
+/// scene as its file says), reading `sensors` (indices). `each` hears every
+/// combination's outcome as it comes, with the share done (a viewer fills
+/// its heat map in).
 pub fn sweep(
     model: &mut LightModel,
     variation: &Variation,
@@ -272,7 +273,7 @@ pub fn sweep(
     range: Range<usize>,
     sensors: &[usize],
     target: Target,
-    progress: &dyn Fn(f64),
+    each: &dyn Fn(&Outcome, f64),
 ) -> Vec<Outcome> {
     let coefficients = variation.is_panel().then(|| model.sensor_coefficients());
     let total = range.len().max(1);
@@ -292,8 +293,9 @@ pub fn sweep(
                     evaluate(&varied, &varied.sensor_coefficients(), sensors, target)
                 }
             });
-            progress((done + 1) as f64 / total as f64);
-            Outcome { values, result }
+            let outcome = Outcome { values, result };
+            each(&outcome, (done + 1) as f64 / total as f64);
+            outcome
         })
         .collect()
 }

@@ -7,12 +7,13 @@
 //! - sensors: markers, picking, a sensor's day and year ([`sensors`]),
 //! - the annual study: a weather file, its hour's sky, the year in the
 //!   background and the sensors coloured by a metric ([`annual`]),
+//! - sweeps of a window material's keys, applied by a click ([`sweep`]),
 //! - panel lobes ([`lobes`]), saving the view ([`capture`]),
 //! - the batch flow of `view --screenshot/--hdr/--sensor` ([`batch`]).
 //!
 //! The modules form a one-way graph: `schedule` (the system sets),
 //! `focus`, `widgets` and `background` are leaves;
-//! `camera`, `capture`, `sensors`, `annual` and `lobes` read them; `ui`
+//! `camera`, `capture`, `sensors`, `annual`, `sweep` and `lobes` read them; `ui`
 //! and `batch` read everything and nothing imports `ui`.
 
 pub mod annual;
@@ -24,6 +25,7 @@ pub mod focus;
 pub mod lobes;
 pub mod schedule;
 pub mod sensors;
+pub mod sweep;
 pub mod ui;
 pub mod widgets;
 
@@ -83,6 +85,7 @@ impl Plugin for ViewerPlugin {
             capture::CapturePlugin,
             sensors::SensorsPlugin,
             annual::AnnualPlugin,
+            sweep::SweepPlugin,
             lobes::LobesPlugin,
             batch::BatchPlugin,
         ));

@@ -141,7 +141,7 @@ pub fn run(args: &SweepArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     };
     let mut model = precompute_for_command(scene.clone(), args.no_cache)?;
     let progress = progress_bar("sweeping");
-    let outcomes = sweep(&mut model, &variation, &grid, range, &sensors, target, &|done| progress.set_position((done * 1000.0) as u64));
+    let outcomes = sweep(&mut model, &variation, &grid, range, &sensors, target, &|_, done| progress.set_position((done * 1000.0) as u64));
     progress.finish_and_clear();
 
     let names: Vec<String> = sensors.iter().map(|&s| scene.sensors[s].name.clone()).collect();

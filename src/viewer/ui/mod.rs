@@ -1,7 +1,8 @@
 //! [`DesignerUiPlugin`]: the designer's panels (bevy_egui), one file per
 //! panel. Left: the sun and sky ([`sun_and_sky`]: date, time, play, site
 //! and north with a sun-path diagram, sky type and parameters, exposure),
-//! then the windows and materials ([`materials`]). Right: the camera
+//! then the windows and materials ([`materials`]) and the sweep of a window
+//! material's keys ([`sweep`]). Right: the camera
 //! ([`camera`]: presets, viewpoints, walk mode), the view ([`view`]: modes,
 //! the light's progress, saving the image) and the sensors ([`sensors`]:
 //! live table, the selected one's day and year, CSV export) and the annual
@@ -18,6 +19,7 @@ pub mod camera;
 pub mod materials;
 pub mod sensors;
 pub mod sun_and_sky;
+pub mod sweep;
 pub mod view;
 
 use bevy::camera::visibility::RenderLayers;
@@ -38,6 +40,7 @@ use annual::AnnualPanel;
 use materials::{MaterialEdits, MaterialPanel};
 use sensors::SensorPanel;
 use sun_and_sky::{PlayDay, SunAndSkyPanel};
+use sweep::SweepPanel;
 use view::ViewPanel;
 
 pub struct DesignerUiPlugin;
@@ -86,6 +89,7 @@ fn panels(
     mut view: ViewPanel,
     mut sensors: SensorPanel,
     mut annual: AnnualPanel,
+    mut sweep: SweepPanel,
     window: Single<&Window, With<PrimaryWindow>>,
     mut cameras: Query<&mut Camera, PictureCamera>,
 ) -> Result {
@@ -101,6 +105,8 @@ fn panels(
                 }
                 ui.separator();
                 materials.show(ui, &mut note.0, sun_and_sky.north_turn());
+                ui.separator();
+                sweep.show(ui);
             });
         })
         .response
