@@ -64,6 +64,11 @@ impl Openings {
     /// window; empty when none can.
     pub(super) fn ways_in(&self, patch: usize, beams: &[SunBeam]) -> Vec<WayIn> {
         let (centre, radius) = self.spheres[patch];
+        self.ways_into_sphere(centre, radius, beams)
+    }
+
+    /// [`Self::ways_in`] for any sphere (a sensor's points, say).
+    pub(super) fn ways_into_sphere(&self, centre: DVec3, radius: f64, beams: &[SunBeam]) -> Vec<WayIn> {
         let mut ways = Vec::new();
         for (b, beam) in beams.iter().enumerate() {
             for (w, ([min, max], group)) in self.windows.iter().enumerate() {
@@ -75,12 +80,19 @@ impl Openings {
         ways
     }
 
-    /// Whether a point of a patch may be reached by one of its `ways` in.
-    pub(super) fn point_may_be_reached(&self, point: DVec3, ways: &[WayIn], beams: &[SunBeam]) -> bool {
-        ways.iter().any(|way| {
-            let [min, max] = self.windows[way.window as usize].0;
-            ray_meets_box(point, beams[way.beam as usize].to_light, min, max)
-        })
+    /// The beams (indices, ascending) that may reach a point of a patch by
+    /// one of its `ways` in; the others cannot.
+    pub(super) fn beams_reaching(&self, point: DVec3, ways: &[WayIn], beams: &[SunBeam]) -> Vec<usize> {
+        let mut reaching: Vec<usize> = ways
+            .iter()
+            .filter(|way| {
+                let [min, max] = self.windows[way.window as usize].0;
+                ray_meets_box(point, beams[way.beam as usize].to_light, min, max)
+            })
+            .map(|way| way.beam as usize)
+            .collect();
+        reaching.dedup();
+        reaching
     }
 }
 

@@ -6,8 +6,9 @@
 
 use glam::DVec3;
 
+use super::SkyKey;
 use super::gather::sample_area;
-use super::openings::{Openings, WayIn};
+use super::openings::WayIn;
 use super::panels::{self, SunBeam};
 use super::sampling::Rng;
 use super::{LightModel, MAX_GLASS_DEPTH, SURFACE_OFFSET, Surface, par_map};
@@ -32,12 +33,19 @@ pub(super) enum Reach {
     Through(Vec<WayIn>),
 }
 
-impl Reach {
-    fn may_reach(&self, openings: &Openings, point: DVec3, beams: &[SunBeam]) -> bool {
-        match self {
-            Reach::None => false,
-            Reach::Open => true,
-            Reach::Through(ways) => openings.point_may_be_reached(point, ways, beams),
+impl LightModel {
+    /// The beams' irradiance at `point` of a side they `reach`: every beam
+    /// on an open side; on an enclosed one only the beams whose ray may
+    /// pass one of their windows (the others are blocked: not traced).
+    fn reaching_irradiance(&self, reach: &Reach, point: DVec3, normal: DVec3, beams: &[SunBeam]) -> f64 {
+        match reach {
+            Reach::None => 0.0,
+            Reach::Open => self.beams_irradiance(point, normal, beams),
+            Reach::Through(ways) => {
+                let (origin, sun) = (point + normal * SURFACE_OFFSET, beams[0].to_light);
+                let reaching = self.openings.beams_reaching(point, ways, beams);
+                reaching.iter().map(|&b| self.beam_irradiance(origin, normal, &beams[b], sun)).sum()
+            }
         }
     }
 }
@@ -125,11 +133,8 @@ impl LightModel {
             let mut rng = Rng::new(3, side as u64);
             let n = self.settings.sun_samples_per_patch;
             let normal = self.side_normal(side as u32);
-            let total: f64 = (0..n)
-                .map(|_| sample_area(&triangles, &mut rng))
-                .filter(|&point| reach.may_reach(&self.openings, point, beams))
-                .map(|point| self.beams_irradiance(point, normal, beams))
-                .sum();
+            let total: f64 =
+                (0..n).map(|_| sample_area(&triangles, &mut rng)).map(|point| self.reaching_irradiance(&reach, point, normal, beams)).sum();
             (total / n as f64, reach)
         });
         let (irradiance, reach) = sides.into_iter().unzip();
@@ -161,9 +166,20 @@ impl LightModel {
     }
 
     /// Sensor `index`'s direct sun (W/m², averaged over its sun points).
+    /// An enclosed sensor (no gather ray reached the open sky) is traced
+    /// only along beams that may pass a window, as sides are.
     pub(super) fn sensor_direct_sun(&self, index: usize, beams: &[SunBeam]) -> f64 {
         let geometry = &self.sensors[index];
-        let total: f64 = geometry.sun_points.iter().map(|&p| self.beams_irradiance(p, geometry.normal, beams)).sum();
+        let bins = self.bin_count();
+        let open = geometry.gather.daylight_coefficients.first().is_some_and(|&(k, _)| SkyKey::unpack(k, bins).window.is_none());
+        let reach = if open || beams.is_empty() {
+            Reach::Open
+        } else {
+            let centre = geometry.sun_points.iter().sum::<DVec3>() / geometry.sun_points.len() as f64;
+            let radius = geometry.sun_points.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
+            Reach::Through(self.openings.ways_into_sphere(centre, radius, beams))
+        };
+        let total: f64 = geometry.sun_points.iter().map(|&p| self.reaching_irradiance(&reach, p, geometry.normal, beams)).sum();
         total / geometry.sun_points.len() as f64
     }
 
@@ -183,8 +199,8 @@ impl LightModel {
             let normal = self.side_normal(side);
             for &(_, share, point) in run {
                 let point = glam::Vec3::from_array(point).as_dvec3();
-                if reach.may_reach(&self.openings, point, beams) {
-                    let e = self.beams_irradiance(point, normal, beams);
+                let e = self.reaching_irradiance(reach, point, normal, beams);
+                if e > 0.0 {
                     for (b, r) in bounce.iter_mut().zip(rho) {
                         *b += f64::from(share) * r * e;
                     }
