@@ -20,8 +20,7 @@ fn weather() -> Weather {
     let path = std::env::var_os("HELIODON_BENCH_EPW")
         .map(PathBuf::from)
         .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/weather/chicago.epw"));
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e} (set HELIODON_BENCH_EPW to an EPW file)", path.display()));
-    Weather::parse_epw(&text, &path).unwrap()
+    Weather::read(&path).unwrap_or_else(|e| panic!("{e} (set HELIODON_BENCH_EPW to an EPW file)"))
 }
 
 fn scenes() -> Vec<(&'static str, Arc<Scene>)> {

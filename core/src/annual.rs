@@ -283,7 +283,6 @@ pub fn annual(
     });
     let lit = |k: usize| skies[k].as_ref().ok().and_then(Option::as_ref);
     let suns = |hours: &mut dyn Iterator<Item = usize>| -> Vec<DVec3> { hours.filter_map(|k| lit(k)?.sun).map(|s| s.direction).collect() };
-    let sun_path = SunPath::new(model, coefficients, site, &suns(&mut (0..HOURS)), None);
 
     // Which shade groups are down in each hour (a bit per group), and the
     // light with each combination that occurs.
@@ -295,6 +294,8 @@ pub fn annual(
         Some(sky) if groups > 0 && occupancy.contains(weather.hours[k].hour) => shades_down(model, sky),
         _ => 0,
     });
+    // Each model's sun path around the suns of the hours it reads.
+    let sun_path = SunPath::new(model, coefficients, site, &suns(&mut (0..HOURS).filter(|&k| down[k] == 0)), None);
     let combinations: std::collections::BTreeSet<u32> = down.iter().copied().filter(|&m| m != 0).collect();
     let shaded_models: Vec<(u32, LightModel)> = combinations
         .into_iter()
@@ -326,13 +327,13 @@ pub fn annual(
             tally.skipped += usize::from(skies[k].is_err());
             // (total with the hour's shades, direct sun with every shade up) per sensor.
             let readings: Option<Vec<(f64, f64)>> = lit(k).map(|sky| {
-                let up = coefficients.readings_on_path(model, sky, &sun_path, Some(1));
                 match shaded.iter().find(|(mask, ..)| *mask == down[k]) {
-                    Some((_, model, coefficients, path)) => {
-                        let lowered = coefficients.readings_on_path(model, sky, path, Some(1));
-                        lowered.iter().zip(&up).map(|(l, u)| (l.total, u.direct_sun)).collect()
+                    // With shades down only the direct sun is needed with them up (for ASE).
+                    Some((_, shaded_model, coefficients, path)) => {
+                        let lowered = coefficients.readings_on_path(shaded_model, sky, path, Some(1));
+                        lowered.iter().zip(model.sensors_direct_sun(sky, Some(1))).map(|(l, sun)| (l.total, sun)).collect()
                     }
-                    None => up.iter().map(|r| (r.total, r.direct_sun)).collect(),
+                    None => coefficients.readings_on_path(model, sky, &sun_path, Some(1)).iter().map(|r| (r.total, r.direct_sun)).collect(),
                 }
             });
             if occupancy.contains(hour.hour) {

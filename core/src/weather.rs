@@ -65,7 +65,24 @@ pub struct Weather {
     pub hours: Vec<WeatherHour>,
 }
 
+impl Station {
+    /// Whether the station is more than 1° of latitude or longitude, or a
+    /// time zone, from `site`: its weather is then not the site's (the
+    /// contract's warning).
+    pub fn is_far_from(&self, site: &crate::site::Site) -> bool {
+        (self.latitude - site.latitude).abs() > 1.0
+            || (self.longitude - site.longitude).abs() > 1.0
+            || (self.timezone - site.timezone).abs() >= 1.0
+    }
+}
+
 impl Weather {
+    /// Reads an EPW file; errors name it.
+    pub fn read(path: &Path) -> Result<Self, String> {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        Self::parse_epw(&text, path)
+    }
+
     /// Reads an EPW file's text; `path` names it in errors.
     pub fn parse_epw(text: &str, path: &Path) -> Result<Self, String> {
         let at = |line: usize, what: String| format!("{}:{line}: {what}", path.display());

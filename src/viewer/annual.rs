@@ -103,8 +103,7 @@ pub struct AnnualStudy {
 impl AnnualStudy {
     /// Opens an EPW file: its sky drives the view from now on.
     pub fn open(&mut self, path: &Path) -> Result<(), String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let weather = Weather::parse_epw(&text, path)?;
+        let weather = Weather::read(path)?;
         self.weather = Some((path.to_path_buf(), Arc::new(weather)));
         self.weather_sky = true;
         self.result = Background::default();

@@ -36,7 +36,7 @@ use glam::DVec3;
 
 use super::daylight::RadianceSlots;
 use super::sun::Reach;
-use super::{LightModel, SensorReading, SunBeam, Surface, luminous, par_map};
+use super::{LightModel, SensorReading, SunBeam, luminous, par_map};
 use crate::site::Site;
 use crate::sky::{LUMINOUS_EFFICACY, Sky, SunSource};
 
@@ -69,12 +69,7 @@ impl LightModel {
         let sensors = self.sensors.len();
         let sides = self.side_gathers.len();
         let slots = self.radiance_slots();
-        let reflectance: Vec<[f32; 3]> = (0..sides)
-            .map(|side| match self.surfaces[self.scene.patches.patches[side / 2].material as usize] {
-                Surface::Diffuse(rho) => rho.map(|r| r as f32),
-                _ => [0.0; 3],
-            })
-            .collect();
+        let reflectance: Vec<[f32; 3]> = (0..sides).map(|side| self.side_reflectance(side).unwrap_or_default().map(|r| r as f32)).collect();
         let transposed = self.transposed_form_factors();
         let mut sky = vec![0.0f32; slots.len() * sensors];
         let mut sun = vec![0.0f32; sides * sensors];
@@ -232,7 +227,7 @@ impl SensorCoefficients {
         add_products(&mut indirect, slot_radiance.iter().zip(self.sky.chunks_exact(count.max(1))));
         par_map(threads, count, |i| {
             let geometry = &model.sensors[i];
-            let direct_sun = (seen.panel_sun_irradiance(&geometry.gather) + model.sensor_direct_sun(i, &beams)) * LUMINOUS_EFFICACY;
+            let direct_sun = model.direct_sun_lux(&seen, i, &beams);
             let direct_sky = seen.sky_irradiance(&geometry.gather) * LUMINOUS_EFFICACY;
             SensorReading {
                 name: model.scene.sensors[i].name.clone(),
@@ -302,9 +297,9 @@ impl SunPath {
     pub fn new(model: &LightModel, coefficients: &SensorCoefficients, site: &Site, suns: &[DVec3], threads: Option<usize>) -> Self {
         let latitude = site.latitude.to_radians();
         let mut path = Self { latitude: latitude.sin_cos(), north_turn: site.north_turn.to_radians(), nodes: Default::default() };
-        let mut needed: Vec<(i32, i32)> =
+        // Each node once, in order (a BTreeSet's order), so threads split the same work.
+        let needed: Vec<(i32, i32)> =
             suns.iter().flat_map(|&sun| path.cell(sun).0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
-        needed.sort_unstable();
         let values = par_map(threads, needed.len(), |k| {
             let direction = path.direction(needed[k]);
             let sun = SunSource { direction, solid_angle: 1.0, radiance: 1.0 };

@@ -255,9 +255,23 @@ impl LightModel {
     }
 
     /// Whether some gather ray of the side left straight to the open sky or
-    /// ground, through no window (keys are sorted, windowless ones first).
+    /// ground, through no window.
     fn side_is_open(&self, side: usize) -> bool {
-        self.side_gathers[side].daylight_coefficients.first().is_some_and(|&(k, _)| SkyKey::unpack(k, self.bin_count()).window.is_none())
+        self.sees_open_sky(&self.side_gathers[side])
+    }
+
+    /// Whether some ray of `gather` left straight to the open sky or ground
+    /// (keys are sorted, windowless ones first).
+    fn sees_open_sky(&self, gather: &Gather) -> bool {
+        gather.daylight_coefficients.first().is_some_and(|&(k, _)| SkyKey::unpack(k, self.bin_count()).window.is_none())
+    }
+
+    /// The diffuse reflectance (RGB) of a patch side; `None` for glass and panels.
+    fn side_reflectance(&self, side: usize) -> Option<[f64; 3]> {
+        match self.surfaces[self.scene.patches.patches[side / 2].material as usize] {
+            Surface::Diffuse(rho) => Some(rho),
+            _ => None,
+        }
     }
 
     /// Bins of the sky sphere (sky above the horizon, ground below).

@@ -80,19 +80,21 @@ impl Openings {
         ways
     }
 
-    /// The beams (indices, ascending) that may reach a point of a patch by
-    /// one of its `ways` in; the others cannot.
-    pub(super) fn beams_reaching(&self, point: DVec3, ways: &[WayIn], beams: &[SunBeam]) -> Vec<usize> {
-        let mut reaching: Vec<usize> = ways
-            .iter()
-            .filter(|way| {
-                let [min, max] = self.windows[way.window as usize].0;
-                ray_meets_box(point, beams[way.beam as usize].to_light, min, max)
+    /// The beams (indices, ascending, each once) that may reach a point of a
+    /// patch by one of its `ways` in; the others cannot. No allocation: it
+    /// runs for every traced point.
+    pub(super) fn beams_reaching<'a>(&'a self, point: DVec3, ways: &'a [WayIn], beams: &'a [SunBeam]) -> impl Iterator<Item = usize> + 'a {
+        // Ways come beam by beam: a beam already let through skips its other windows.
+        let mut last = None;
+        ways.iter().filter_map(move |way| {
+            let beam = way.beam as usize;
+            let [min, max] = self.windows[way.window as usize].0;
+            let through = last != Some(beam) && ray_meets_box(point, beams[beam].to_light, min, max);
+            through.then(|| {
+                last = Some(beam);
+                beam
             })
-            .map(|way| way.beam as usize)
-            .collect();
-        reaching.dedup();
-        reaching
+        })
     }
 }
 

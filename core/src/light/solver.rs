@@ -12,7 +12,7 @@
 //! Every product of form factors and exitance, for patch sides and for
 //! sensors alike, is [`form_factor_product`].
 
-use super::{Channels, LightModel, Lighting, SensorReading, Surface, par_map};
+use super::{Channels, LightModel, Lighting, SensorReading, par_map};
 use crate::sky::{LUMINOUS_EFFICACY, Sky};
 
 /// `start` + Σ_j F_ij M_j over one sparse row of form factors: the
@@ -137,7 +137,7 @@ impl LightModel {
         let sides_sun = self.sun_on_sides(&beams, None, self.settings.threads);
         let direct: Vec<Channels> = par_map(self.settings.threads, patches.len() * 2, |side| {
             let gather = &self.side_gathers[side];
-            if !matches!(self.surfaces[patches[side / 2].material as usize], Surface::Diffuse(_)) {
+            if self.side_reflectance(side).is_none() {
                 return Channels::default();
             }
             let diffuse_sun = seen.panel_sun_irradiance(gather);
@@ -148,12 +148,7 @@ impl LightModel {
                 ..Default::default()
             }
         });
-        let reflectance: Vec<[f64; 3]> = (0..patches.len() * 2)
-            .map(|side| match self.surfaces[patches[side / 2].material as usize] {
-                Surface::Diffuse(rho) => rho,
-                _ => [0.0; 3],
-            })
-            .collect();
+        let reflectance: Vec<[f64; 3]> = (0..patches.len() * 2).map(|side| self.side_reflectance(side).unwrap_or_default()).collect();
         // Each sensor's direct light and the first bounce of sun where its rays land.
         let sensors: Vec<SensorDirect> = par_map(self.settings.threads, self.sensors.len(), |i| {
             let geometry = &self.sensors[i];

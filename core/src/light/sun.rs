@@ -6,7 +6,6 @@
 
 use glam::DVec3;
 
-use super::SkyKey;
 use super::gather::sample_area;
 use super::openings::WayIn;
 use super::panels::{self, SunBeam};
@@ -43,8 +42,7 @@ impl LightModel {
             Reach::Open => self.beams_irradiance(point, normal, beams),
             Reach::Through(ways) => {
                 let (origin, sun) = (point + normal * SURFACE_OFFSET, beams[0].to_light);
-                let reaching = self.openings.beams_reaching(point, ways, beams);
-                reaching.iter().map(|&b| self.beam_irradiance(origin, normal, &beams[b], sun)).sum()
+                self.openings.beams_reaching(point, ways, beams).map(|b| self.beam_irradiance(origin, normal, &beams[b], sun)).sum()
             }
         }
     }
@@ -148,8 +146,7 @@ impl LightModel {
     }
 
     fn side_reach(&self, side: usize, beams: &[SunBeam], wanted: Option<&[bool]>) -> Reach {
-        let patch = &self.scene.patches.patches[side / 2];
-        if beams.is_empty() || wanted.is_some_and(|w| !w[side]) || !matches!(self.surfaces[patch.material as usize], Surface::Diffuse(_)) {
+        if beams.is_empty() || wanted.is_some_and(|w| !w[side]) || self.side_reflectance(side).is_none() {
             return Reach::None;
         }
         let normal = self.side_normal(side as u32);
@@ -165,14 +162,25 @@ impl LightModel {
         }
     }
 
+    /// Every sensor's direct sun under `sky` (lux): its beams and the sun
+    /// panels transmit diffusely, what ASE counts (`threads` as [`par_map`]).
+    pub fn sensors_direct_sun(&self, sky: &crate::sky::Sky, threads: Option<usize>) -> Vec<f64> {
+        let seen = self.key_radiance(sky);
+        let beams = sky.sun.filter(|s| s.direction.z > 0.0).map(|s| self.sun_beams(&s)).unwrap_or_default();
+        par_map(threads, self.sensors.len(), |i| self.direct_sun_lux(&seen, i, &beams))
+    }
+
+    /// Sensor `index`'s direct sun in lux, `seen` the sky's key radiance.
+    pub(super) fn direct_sun_lux(&self, seen: &super::daylight::KeyRadiance, index: usize, beams: &[SunBeam]) -> f64 {
+        (seen.panel_sun_irradiance(&self.sensors[index].gather) + self.sensor_direct_sun(index, beams)) * crate::sky::LUMINOUS_EFFICACY
+    }
+
     /// Sensor `index`'s direct sun (W/m², averaged over its sun points).
     /// An enclosed sensor (no gather ray reached the open sky) is traced
     /// only along beams that may pass a window, as sides are.
     pub(super) fn sensor_direct_sun(&self, index: usize, beams: &[SunBeam]) -> f64 {
         let geometry = &self.sensors[index];
-        let bins = self.bin_count();
-        let open = geometry.gather.daylight_coefficients.first().is_some_and(|&(k, _)| SkyKey::unpack(k, bins).window.is_none());
-        let reach = if open || beams.is_empty() {
+        let reach = if self.sees_open_sky(&geometry.gather) || beams.is_empty() {
             Reach::Open
         } else {
             let centre = geometry.sun_points.iter().sum::<DVec3>() / geometry.sun_points.len() as f64;
@@ -195,7 +203,7 @@ impl LightModel {
             if *reach == Reach::None {
                 continue;
             }
-            let Surface::Diffuse(rho) = self.surfaces[self.scene.patches.patches[side as usize / 2].material as usize] else { continue };
+            let Some(rho) = self.side_reflectance(side as usize) else { continue };
             let normal = self.side_normal(side);
             for &(_, share, point) in run {
                 let point = glam::Vec3::from_array(point).as_dvec3();

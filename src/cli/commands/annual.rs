@@ -44,14 +44,10 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
             args.scene.display()
         )));
     }
-    let text = std::fs::read_to_string(&args.weather).map_err(|e| format!("{}: {e}", args.weather.display()))?;
-    let weather = Weather::parse_epw(&text, &args.weather)?;
+    let weather = Weather::read(&args.weather)?;
     let station = &weather.station;
     let site = &scene.site;
-    if (station.latitude - site.latitude).abs() > 1.0
-        || (station.longitude - site.longitude).abs() > 1.0
-        || (station.timezone - site.timezone).abs() >= 1.0
-    {
+    if station.is_far_from(site) {
         eprintln!(
             "warning: {}: the weather of {} ({:.2}°, {:.2}°, UTC{:+}) is far from the scene's site ({:.2}°, {:.2}°, UTC{:+}); the site's sun is used",
             args.weather.display(),

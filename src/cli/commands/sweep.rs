@@ -120,10 +120,7 @@ pub fn run(args: &SweepArgs, panels: &PanelCatalog) -> Result<(), CliError> {
         None => (0..scene.sensors.len()).collect(),
     };
     let weather = match &args.weather {
-        Some(path) => {
-            let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-            Some(Weather::parse_epw(&text, path)?)
-        }
+        Some(path) => Some(Weather::read(path)?),
         None => None,
     };
     let sky = match (args.date, args.time) {

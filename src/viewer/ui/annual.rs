@@ -31,11 +31,7 @@ pub fn annual_panel(
     };
     let station = &weather.station;
     ui.label(format!("{} ({:.2}°, {:.2}°, UTC{:+})", station.name, station.latitude, station.longitude, station.timezone));
-    if let Some(site) = site
-        && ((station.latitude - site.latitude).abs() > 1.0
-            || (station.longitude - site.longitude).abs() > 1.0
-            || (station.timezone - site.timezone).abs() >= 1.0)
-    {
+    if site.is_some_and(|site| station.is_far_from(site)) {
         ui.colored_label(
             egui::Color32::from_rgb(255, 210, 40),
             "far from the scene's site: its sun is the site's, its weather the station's",
@@ -60,11 +56,7 @@ pub fn annual_panel(
     ui.label(format!("ASE1000/250 {:.1}% of point sensors", year.ase()));
     ui.label(format!("{} occupied hours", year.occupied_hours));
     if ui.button("Save the table (CSV)").clicked() {
-        let name = "heliodon-annual.csv";
-        *note = Some(match std::fs::write(name, year.csv()) {
-            Ok(()) => format!("wrote {}", std::env::current_dir().map(|d| d.join(name).display().to_string()).unwrap_or(name.into())),
-            Err(e) => format!("cannot write {name}: {e}"),
-        });
+        *note = Some(crate::viewer::ui::sensors::write_export("heliodon-annual.csv", &year.csv()));
     }
     let tops = Metric::ALL.map(|m| m.top(year));
     let mut colour_by = study.colour_by;

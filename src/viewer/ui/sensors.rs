@@ -141,7 +141,7 @@ fn year_map(ui: &mut Ui, values: &[Vec<f64>], day: u32, now: f64) {
 }
 
 /// Writes an export into the working folder; what to tell the user.
-fn write_export(name: &str, text: &str) -> String {
+pub(super) fn write_export(name: &str, text: &str) -> String {
     match std::fs::write(name, text) {
         Ok(()) => format!("wrote {}", std::env::current_dir().map(|d| d.join(name).display().to_string()).unwrap_or(name.into())),
         Err(e) => format!("cannot write {name}: {e}"),
