@@ -1,16 +1,18 @@
 //! The annual study's costs on a real year of weather (Chicago TMY3 from
 //! ../shared/data/weather, or the EPW named by `HELIODON_BENCH_EPW`): the
 //! bundled office (150 sensors) and the validation side room (19), cold
-//! (gather, coefficients and the year) and with the light model warm
-//! (coefficients and the year: what `annual` does when the cache is warm).
-//! The parts are printed once beside the measurements.
+//! (gather, coefficients, the year's sun traced, the year) and with the
+//! light cache warm (what `annual` does then: the gathers and the year's
+//! sun read from a cache folder, the coefficients, the year). The parts are
+//! printed once beside the measurements.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use heliodon_core::annual::{AnnualOptions, annual};
+use heliodon_core::annual::{AnnualOptions, SunHours, annual};
+use heliodon_core::light::cache::precompute_cached;
 use heliodon_core::light::{LightModel, LightSettings};
 use heliodon_core::panel::PanelCatalog;
 use heliodon_core::scene::{Scene, load_scene};
@@ -31,13 +33,17 @@ fn scenes() -> Vec<(&'static str, Arc<Scene>)> {
     ]
 }
 
-fn year(model: &LightModel, weather: &Weather) -> f64 {
-    let result = annual(model, &model.scene.site, weather, &AnnualOptions::default(), &|_| {}).unwrap();
-    result.sda()
+fn year(model: &LightModel, weather: &Weather, cache: Option<&Path>) -> f64 {
+    let site = &model.scene.site;
+    let coefficients = model.sensor_coefficients();
+    let (sun_hours, _) = SunHours::cached(model, &coefficients, site, false, cache, &|_| {}).unwrap();
+    let options = AnnualOptions { coefficients: Some(&coefficients), sun_hours: Some(&sun_hours), ..Default::default() };
+    annual(model, site, weather, &options, &|_| {}).unwrap().sda()
 }
 
 fn bench(c: &mut Criterion) {
     let weather = weather();
+    let cache = std::env::temp_dir().join(format!("heliodon-bench-annual-{}", std::process::id()));
     let mut group = c.benchmark_group("annual");
     group.sample_size(10).measurement_time(Duration::from_secs(60));
     for (name, scene) in scenes() {
@@ -46,23 +52,32 @@ fn bench(c: &mut Criterion) {
         let gathered = start.elapsed();
         let coefficients = model.sensor_coefficients();
         let folded = start.elapsed() - gathered;
-        drop(coefficients);
-        let sda = year(&model, &weather);
+        let sun_hours = SunHours::trace(&model, &coefficients, &scene.site, false, None, &|_| {});
+        let traced = start.elapsed() - gathered - folded;
+        drop((coefficients, sun_hours));
+        let sda = year(&model, &weather, None);
         let total = start.elapsed();
         println!(
-            "{name}: {} sensors, {} patches; gather {:.2} s, coefficients {:.2} s, year (coefficients included) {:.2} s; sDA {sda:.1}%",
+            "{name}: {} sensors, {} patches; gather {:.2} s, coefficients {:.2} s, the year's sun {:.2} s, then a year, coefficients and sun included, {:.2} s; sDA {sda:.1}%",
             scene.sensors.len(),
             scene.patches.patches.len(),
             gathered.as_secs_f64(),
             folded.as_secs_f64(),
-            (total - gathered).as_secs_f64()
+            traced.as_secs_f64(),
+            (total - gathered - folded - traced).as_secs_f64()
         );
-        group.bench_function(format!("{name}: year, light model warm"), |b| b.iter(|| year(&model, &weather)));
+        let warm = || {
+            let (model, _) = precompute_cached(scene.clone(), LightSettings::default(), Some(&cache), &|_| {}).unwrap();
+            year(&model, &weather, Some(&cache))
+        };
+        warm();
+        group.bench_function(format!("{name}: year, light cache warm"), |b| b.iter(warm));
         group.bench_function(format!("{name}: year, cold"), |b| {
-            b.iter(|| year(&LightModel::precompute(scene.clone(), LightSettings::default()).unwrap(), &weather))
+            b.iter(|| year(&LightModel::precompute(scene.clone(), LightSettings::default()).unwrap(), &weather, None))
         });
     }
     group.finish();
+    let _ = std::fs::remove_dir_all(&cache);
 }
 
 criterion_group!(benches, bench);

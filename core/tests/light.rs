@@ -564,11 +564,68 @@ fn the_sun_path_reads_what_tracing_reads() {
     for sky in &skies {
         let traced = coefficients.readings(&model, sky, None);
         for (a, b) in traced.iter().zip(coefficients.readings_on_path(&model, sky, &path, None)) {
-            assert_eq!((a.direct_sun, a.direct_sky), (b.direct_sun, b.direct_sky), "the direct light is never interpolated");
+            // The direct light is never interpolated: the path's reading
+            // keeps the sun per W/m² in f32, so they agree to its rounding.
+            assert_eq!(a.direct_sky, b.direct_sky);
+            assert!((a.direct_sun - b.direct_sun).abs() <= 1e-6 * a.direct_sun.max(1.0), "{} against {}", b.direct_sun, a.direct_sun);
             errors.push((b.total - a.total).abs() / a.total);
         }
     }
     errors.sort_by(f64::total_cmp);
     let (median, p95, max) = (errors[errors.len() / 2], errors[errors.len() * 95 / 100], errors[errors.len() - 1]);
     assert!(median < 0.005 && p95 < 0.02 && max < 0.05, "median {median}, 95th percentile {p95}, max {max}");
+}
+
+/// The year's sun ([`SunHours`]) goes into the light cache and comes back
+/// whole: the warm year equals the one `annual` traces itself, hour by hour
+/// and bit for bit. Another site or another reflectance is another table
+/// (another key), and `annual` refuses a table that does not fit.
+#[test]
+fn the_years_sun_is_cached_and_a_warm_year_reads_what_a_traced_one_does() {
+    use heliodon_core::annual::{AnnualOptions, SunHours, annual};
+    use heliodon_core::light::cache::CacheOutcome;
+    use heliodon_core::scene::MaterialKind;
+    use heliodon_core::weather::{HOURS, Station, Weather, WeatherHour, calendar};
+    let scene = load(&sideroom());
+    let site = scene.site;
+    let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
+    let coefficients = model.sensor_coefficients();
+    let dir = std::env::temp_dir().join(format!("heliodon-sun-hours-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let cached = |model: &LightModel, site: &heliodon_core::site::Site| {
+        SunHours::cached(model, &coefficients, site, false, Some(&dir), &|_| {}).unwrap()
+    };
+    let (cold, outcome) = cached(&model, &site);
+    assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");
+    let (warm, outcome) = cached(&model, &site);
+    assert!(matches!(outcome, CacheOutcome::Hit(_)), "{outcome:?}");
+    assert_eq!(cold, warm);
+
+    // Sunny every third day, overcast otherwise.
+    let hours = (0..HOURS)
+        .map(|k| {
+            let (month, day, hour) = calendar(k);
+            let direct_normal = if day % 3 == 0 { 650.0 } else { 0.0 };
+            WeatherHour { month, day, hour, direct_normal, diffuse_horizontal: 110.0, missing: false }
+        })
+        .collect();
+    let station =
+        Station { name: "synthetic".into(), latitude: site.latitude, longitude: site.longitude, timezone: site.timezone, elevation: 0.0 };
+    let weather = Weather { station, hours };
+    let traced = annual(&model, &site, &weather, &AnnualOptions { keep_hourly: true, ..Default::default() }, &|_| {}).unwrap();
+    let options = AnnualOptions { keep_hourly: true, coefficients: Some(&coefficients), sun_hours: Some(&warm), ..Default::default() };
+    let read = annual(&model, &site, &weather, &options, &|_| {}).unwrap();
+    assert_eq!(traced, read);
+    assert!(read.sensors.iter().any(|s| s.ase_hours > 0) && read.sensors.iter().all(|s| s.da300 > 0.0), "{:?}", read.sensors);
+
+    let moved = heliodon_core::site::Site { latitude: site.latitude + 5.0, ..site };
+    assert!(matches!(cached(&model, &moved).1, CacheOutcome::Stored(_)), "another site, another table");
+    let refused = annual(&model, &moved, &weather, &options, &|_| {});
+    assert!(refused.is_err_and(|e| e.contains("another scene, site")));
+    let mut repainted = (*scene).clone();
+    let wall = repainted.materials.iter_mut().find(|m| matches!(m.kind, MaterialKind::Diffuse { .. })).unwrap();
+    wall.kind = MaterialKind::Diffuse { reflectance: heliodon_core::scene::Rgb([0.123, 0.456, 0.789]) };
+    let repainted = LightModel::precompute(Arc::new(repainted), LightSettings::default()).unwrap();
+    assert_ne!(SunHours::key(&repainted, &site, false), SunHours::key(&model, &site, false), "reflectances are in the key");
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -13,8 +13,8 @@ use bevy::prelude::*;
 
 use super::background::Background;
 use super::schedule::ViewerSystems;
-use crate::annual::{AnnualOptions, AnnualResult, SensorYear, annual};
-use crate::ecs::{ActiveScene, LightEngine, Site, SkyChoice, SolarTime};
+use crate::annual::{AnnualOptions, AnnualResult, SensorYear, SunHours, annual};
+use crate::ecs::{ActiveScene, LightCacheDir, LightEngine, Site, SkyChoice, SolarTime};
 use crate::sky::{SkySpec, perez};
 use crate::weather::Weather;
 
@@ -153,7 +153,7 @@ fn sky_from_weather(mut study: ResMut<AnnualStudy>, time: Res<SolarTime>, mut sk
 }
 
 /// Starts the year when asked (once the light model is there), and collects it.
-fn update_annual(mut study: ResMut<AnnualStudy>, engine: Option<Res<LightEngine>>, site: Option<Res<Site>>) {
+fn update_annual(mut study: ResMut<AnnualStudy>, engine: Option<Res<LightEngine>>, site: Option<Res<Site>>, cache_dir: Res<LightCacheDir>) {
     study.result.collect();
     let (Some(model), Some(site)) = (engine.and_then(|e| e.model.clone()), site) else { return };
     let key = study.weather.as_ref().map(|(path, _)| format!("{} {:?} {:?}", path.display(), Arc::as_ptr(&model), site.0));
@@ -168,10 +168,16 @@ fn update_annual(mut study: ResMut<AnnualStudy>, engine: Option<Res<LightEngine>
     study.requested = false;
     let done = Arc::new(AtomicUsize::new(0));
     study.done = done.clone();
-    let site = site.0;
+    let (site, dir) = (site.0, cache_dir.0.clone());
     study.result.start(key, move || {
+        // Tracing the year's sun (once per scene and site: then from the cache) is most of the work.
+        const TRACING_SHARE: f64 = 0.95;
         let progress = move |share: f64| done.store((share * 365.0).round() as usize, Ordering::Relaxed);
-        annual(&model, &site, &weather, &AnnualOptions::default(), &progress)
+        let coefficients = model.sensor_coefficients();
+        let (sun_hours, _) =
+            SunHours::cached(&model, &coefficients, &site, false, dir.as_deref(), &|share| progress(TRACING_SHARE * share))?;
+        let options = AnnualOptions { coefficients: Some(&coefficients), sun_hours: Some(&sun_hours), ..Default::default() };
+        annual(&model, &site, &weather, &options, &|share| progress(TRACING_SHARE + (1.0 - TRACING_SHARE) * share))
     });
 }
 

@@ -49,23 +49,28 @@ pub fn default_dir() -> Option<PathBuf> {
     std::env::var_os("HOME").map(|home| PathBuf::from(home).join(".cache/heliodon"))
 }
 
-/// FNV-1a, 64 bits: stable across platforms and Rust versions.
-struct Fnv(u64);
+/// FNV-1a, 64 bits: stable across platforms and Rust versions (the keys
+/// of cache files).
+pub(crate) struct Fnv(pub u64);
 
 impl Fnv {
-    fn new() -> Self {
+    pub fn new() -> Self {
         Self(0xcbf2_9ce4_8422_2325)
     }
 
-    fn bytes(&mut self, data: &[u8]) -> &mut Self {
+    pub fn bytes(&mut self, data: &[u8]) -> &mut Self {
         for &b in data {
             self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
         }
         self
     }
 
-    fn u64(&mut self, v: u64) -> &mut Self {
+    pub fn u64(&mut self, v: u64) -> &mut Self {
         self.bytes(&v.to_le_bytes())
+    }
+
+    pub fn f64(&mut self, v: f64) -> &mut Self {
+        self.u64(v.to_bits())
     }
 }
 
@@ -124,33 +129,54 @@ pub fn precompute_cached(
     progress: &(dyn Fn(f64) + Sync),
 ) -> Result<(LightModel, CacheOutcome), String> {
     settings.check()?;
-    let Some(dir) = dir else {
-        return Ok((LightModel::precompute_with_progress(scene, settings, progress)?, CacheOutcome::Skipped("disabled".into())));
-    };
     let key = key(&scene, &settings);
-    let path = dir.join(format!("light-{key:016x}.bin"));
+    through_cache(
+        dir,
+        &format!("{key:016x}"),
+        key,
+        |payload| LightModel::from_payload(scene.clone(), settings, payload),
+        || LightModel::precompute_with_progress(scene.clone(), settings, progress),
+        LightModel::payload,
+    )
+}
+
+/// One file of the cache (`light-{name}.bin` in `dir`) stored under `key`:
+/// loaded when it is whole and `load` accepts it, else made by `compute`
+/// and stored as `save` writes it (none: no cache, computed each time).
+pub fn through_cache<T>(
+    dir: Option<&Path>,
+    name: &str,
+    key: u64,
+    load: impl FnOnce(&[u8]) -> Option<T>,
+    compute: impl FnOnce() -> Result<T, String>,
+    save: impl FnOnce(&T) -> Vec<u8>,
+) -> Result<(T, CacheOutcome), String> {
+    let Some(dir) = dir else {
+        return Ok((compute()?, CacheOutcome::Skipped("disabled".into())));
+    };
+    let path = dir.join(format!("light-{name}.bin"));
     // Every start tidies: temporary files of processes killed mid-write go,
     // and the folder keeps to its bound.
     tidy(dir, &path, size_limit());
     let mut rebuilt = None;
     if let Ok(bytes) = fs::read(&path) {
         match decode(&bytes, key) {
-            Ok(payload) => match LightModel::from_payload(scene.clone(), settings, &payload) {
-                Some(model) => {
+            Ok(payload) => match load(&payload) {
+                Some(value) => {
                     // Used now: the last to be evicted.
                     let _ = fs::File::options().append(true).open(&path).and_then(|f| f.set_modified(SystemTime::now()));
-                    return Ok((model, CacheOutcome::Hit(path)));
+                    return Ok((value, CacheOutcome::Hit(path)));
                 }
                 None => rebuilt = Some("its contents do not fit the scene".to_string()),
             },
             Err(why) => rebuilt = Some(why),
         }
     }
-    let model = LightModel::precompute_with_progress(scene, settings, progress)?;
+    let value = compute()?;
     let stored = fs::create_dir_all(dir).and_then(|_| {
         // Write then rename, so a reader never sees half a file.
         let partial = path.with_extension(format!("tmp{}", std::process::id()));
-        fs::write(&partial, encode(&model.payload(), key))?;
+        fs::write(&partial, encode(&save(&value), key))?;
         fs::rename(&partial, &path)
     });
     if stored.is_ok() {
@@ -161,7 +187,7 @@ pub fn precompute_cached(
         (Ok(()), Some(why)) => CacheOutcome::Rebuilt(path, why),
         (Ok(()), None) => CacheOutcome::Stored(path),
     };
-    Ok((model, outcome))
+    Ok((value, outcome))
 }
 
 /// The cache folder's bound in bytes: `$HELIODON_CACHE_MAX_MB` (MiB), else
@@ -244,7 +270,7 @@ fn decode(bytes: &[u8], key: u64) -> Result<Vec<u8>, String> {
 
 /// Little-endian writer of the payload.
 #[derive(Default)]
-pub(super) struct Writer(pub Vec<u8>);
+pub(crate) struct Writer(pub Vec<u8>);
 
 impl Writer {
     pub fn u32(&mut self, v: u32) {
@@ -293,7 +319,7 @@ impl Writer {
 }
 
 /// Reader of the payload; `None` when it runs out.
-pub(super) struct Reader<'a>(pub &'a [u8]);
+pub(crate) struct Reader<'a>(pub &'a [u8]);
 
 impl Reader<'_> {
     fn take(&mut self, n: usize) -> Option<&[u8]> {

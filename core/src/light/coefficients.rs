@@ -187,47 +187,85 @@ impl LightModel {
     }
 }
 
+/// The sun's light at every sensor per W/m² of direct normal irradiance,
+/// for one sun direction: what an hour's sun scales (the light is linear in
+/// it), so a year of hours can keep one response per sun position.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SunResponse {
+    /// Straight from the sun and its panel lobes, lux per W/m².
+    pub direct: Vec<f32>,
+    /// Interreflected: the first bounce traced where the sensors' rays
+    /// land, the later bounces read from a [`SunPath`]; lux per W/m².
+    pub interreflected: Vec<f32>,
+}
+
+/// The sun's light at every sensor, lux: straight (beams and lobes, not
+/// what panels diffuse) and interreflected.
+struct SunLux {
+    direct: Vec<f64>,
+    interreflected: Vec<f64>,
+}
+
 impl SensorCoefficients {
     /// Every sensor's reading under `sky` (`threads` as [`par_map`]): equal
     /// to [`LightModel::solve`]'s up to its tolerance.
     pub fn readings(&self, model: &LightModel, sky: &Sky, threads: Option<usize>) -> Vec<SensorReading> {
-        self.read(model, sky, threads, |beams| self.interreflected_sun(model, beams, threads))
+        let beams = sky.sun.filter(|s| s.direction.z > 0.0).map(|s| model.sun_beams(&s)).unwrap_or_default();
+        let direct = par_map(threads, model.sensors.len(), |i| model.sensor_direct_sun(i, &beams) * LUMINOUS_EFFICACY);
+        self.read(model, sky, SunLux { direct, interreflected: self.interreflected_sun(model, &beams, threads) }, threads)
     }
 
     /// [`Self::readings`] with the sun's light beyond its first bounce read
     /// from a [`SunPath`] instead of traced; the direct sun and its first
     /// bounce where the sensors' rays land are still traced.
     pub fn readings_on_path(&self, model: &LightModel, sky: &Sky, path: &SunPath, threads: Option<usize>) -> Vec<SensorReading> {
-        self.read(model, sky, threads, |beams| {
-            let mut lux = self.first_bounce(model, beams, &model.sides_reach(beams, Some(&self.seen), threads), threads);
-            if let Some(sun) = sky.sun.filter(|s| s.direction.z > 0.0) {
-                for (e, later) in lux.iter_mut().zip(path.later_bounces(sun.direction)) {
-                    *e += sun.normal_irradiance() * later;
-                }
-            }
-            lux
-        })
+        let response = sky.sun.filter(|s| s.direction.z > 0.0).map(|s| self.sun_response(model, s.direction, path, threads));
+        self.readings_with_sun(model, sky, response.as_ref(), threads)
     }
 
-    /// The readings, with the sun's interreflected light (lux per sensor)
-    /// from `interreflected_sun` of the sky's beams.
-    fn read(
+    /// The readings under `sky` with the sun's light from `response` (its
+    /// sun's direction; `None` when the sun is down), scaled by the sky's
+    /// sun: no ray is traced.
+    pub fn readings_with_sun(
         &self,
         model: &LightModel,
         sky: &Sky,
+        response: Option<&SunResponse>,
         threads: Option<usize>,
-        interreflected_sun: impl FnOnce(&[SunBeam]) -> Vec<f64>,
     ) -> Vec<SensorReading> {
         let count = model.sensors.len();
+        let normal_irradiance = sky.sun.filter(|s| s.direction.z > 0.0).map_or(0.0, |s| s.normal_irradiance());
+        let scaled = |per_unit: Option<&Vec<f32>>| match per_unit {
+            Some(values) if normal_irradiance > 0.0 => values.iter().map(|&v| normal_irradiance * f64::from(v)).collect(),
+            _ => vec![0.0; count],
+        };
+        let sun = SunLux { direct: scaled(response.map(|r| &r.direct)), interreflected: scaled(response.map(|r| &r.interreflected)) };
+        self.read(model, sky, sun, threads)
+    }
+
+    /// The sun's light at every sensor for a sun of 1 W/m² normal
+    /// irradiance from `direction`: the beams and their first bounce traced,
+    /// the later bounces from `path`.
+    pub fn sun_response(&self, model: &LightModel, direction: DVec3, path: &SunPath, threads: Option<usize>) -> SunResponse {
+        let beams = model.sun_beams(&SunSource { direction, solid_angle: 1.0, radiance: 1.0 });
+        let reach = model.sides_reach(&beams, Some(&self.seen), threads);
+        let first = self.first_bounce(model, &beams, &reach, threads);
+        let direct = par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, &beams) * LUMINOUS_EFFICACY) as f32);
+        let interreflected = first.iter().zip(path.later_bounces(direction)).map(|(first, later)| (first + later) as f32).collect();
+        SunResponse { direct, interreflected }
+    }
+
+    /// The readings with the sun's light at every sensor given.
+    fn read(&self, model: &LightModel, sky: &Sky, sun: SunLux, threads: Option<usize>) -> Vec<SensorReading> {
+        let count = model.sensors.len();
         let seen = model.key_radiance(sky);
-        let beams = sky.sun.filter(|s| s.direction.z > 0.0).map(|s| model.sun_beams(&s)).unwrap_or_default();
-        let mut indirect = interreflected_sun(&beams);
+        let mut indirect = sun.interreflected;
         let slot_radiance = seen.slots();
         debug_assert_eq!(slot_radiance.len(), self.slots.len());
         add_products(&mut indirect, slot_radiance.iter().zip(self.sky.chunks_exact(count.max(1))));
         par_map(threads, count, |i| {
             let geometry = &model.sensors[i];
-            let direct_sun = model.direct_sun_lux(&seen, i, &beams);
+            let direct_sun = seen.panel_sun_irradiance(&geometry.gather) * LUMINOUS_EFFICACY + sun.direct[i];
             let direct_sky = seen.sky_irradiance(&geometry.gather) * LUMINOUS_EFFICACY;
             SensorReading {
                 name: model.scene.sensors[i].name.clone(),

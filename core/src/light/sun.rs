@@ -162,19 +162,6 @@ impl LightModel {
         }
     }
 
-    /// Every sensor's direct sun under `sky` (lux): its beams and the sun
-    /// panels transmit diffusely, what ASE counts (`threads` as [`par_map`]).
-    pub fn sensors_direct_sun(&self, sky: &crate::sky::Sky, threads: Option<usize>) -> Vec<f64> {
-        let seen = self.key_radiance(sky);
-        let beams = sky.sun.filter(|s| s.direction.z > 0.0).map(|s| self.sun_beams(&s)).unwrap_or_default();
-        par_map(threads, self.sensors.len(), |i| self.direct_sun_lux(&seen, i, &beams))
-    }
-
-    /// Sensor `index`'s direct sun in lux, `seen` the sky's key radiance.
-    pub(super) fn direct_sun_lux(&self, seen: &super::daylight::KeyRadiance, index: usize, beams: &[SunBeam]) -> f64 {
-        (seen.panel_sun_irradiance(&self.sensors[index].gather) + self.sensor_direct_sun(index, beams)) * crate::sky::LUMINOUS_EFFICACY
-    }
-
     /// Sensor `index`'s direct sun (W/m², averaged over its sun points).
     /// An enclosed sensor (no gather ray reached the open sky) is traced
     /// only along beams that may pass a window, as sides are.

@@ -12,16 +12,20 @@
 //!    can be made read 0 lux.
 //! 3. Before the first hour, every sensor's radiosity adjoint is solved once
 //!    and folded into coefficients ([`crate::light::coefficients`]): per
-//!    sky bin (and panel group) and per patch side's sun beams; and the
-//!    sun's later bounces are traced at the nodes of a sun path around the
-//!    year's sun positions. A lit hour is then one product of the
-//!    coefficients with the hour's bin radiances, the direct sun and its
-//!    first bounce traced exactly (shadow rays through glass and along panel
-//!    lobes, where the sensors' rays land), the later bounces read from the
-//!    path, and no radiosity solve. Runs of whole days go in parallel; hours
-//!    are independent, so the numbers do not depend on the thread count;
-//!    occupied hours are counted as they come (memory follows sensors, not
-//!    hours, unless every hour is kept for `--hourly`).
+//!    sky bin (and panel group) and per patch side's sun beams. The year's
+//!    sun is traced once per sun-up hour of the calendar ([`SunHours`]): the
+//!    direct sun (shadow rays through glass and along panel lobes) and its
+//!    first bounce where the sensors' rays land, exactly; the later bounces
+//!    from a sun path of 2.5° nodes. Sun positions follow the site, not the
+//!    weather, and the light is linear in the sun's strength, so the table
+//!    is kept in the light cache for every weather file of the site. A lit
+//!    hour is then one product of the coefficients with the hour's bin
+//!    radiances plus the table's row times the hour's direct normal
+//!    irradiance: no ray, no radiosity solve. Runs of whole days go in
+//!    parallel; hours are independent, so the numbers do not depend on the
+//!    thread count; occupied hours are counted as they come (memory follows
+//!    sensors × sun-up hours, not the weather, unless every hour is kept for
+//!    `--hourly`).
 //! 4. ASE counts the direct sun alone (no sky, no interreflection).
 //!
 //! 5. LM-83 operable shades (`[[shades]]`): in each occupied hour a group
@@ -30,11 +34,15 @@
 //!    with those shades drawn in (one model, coefficients and sun path per
 //!    combination of lowered groups that occurs), ASE with every shade up.
 
+mod sun_hours;
+
+pub use sun_hours::SunHours;
+
 use glam::DVec3;
 
 use crate::light::{LightModel, SensorCoefficients, SunPath, par_map};
 use crate::site::Site;
-use crate::sky::{LUMINOUS_EFFICACY, Sky, SkyError, SkySpec, perez, sky_at};
+use crate::sky::{Sky, SkyError, SkySpec, perez, sky_at};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
 use crate::weather::{HOURS, Weather};
 
@@ -251,6 +259,10 @@ pub struct AnnualOptions<'a> {
     /// The model's sensor coefficients, when the caller has them already
     /// (a sweep of panel keys keeps one set for every combination).
     pub coefficients: Option<&'a SensorCoefficients>,
+    /// The year's sun on the model at the site, when the caller has it
+    /// (from the light cache: [`SunHours::cached`]); traced otherwise. With
+    /// shades studied it must keep the shade groups' sun.
+    pub sun_hours: Option<&'a SunHours>,
 }
 
 /// Runs the year. With `options.shades`, every occupied hour lowers the
@@ -276,26 +288,36 @@ pub fn annual(
             &own
         }
     };
-    // Every hour's sky first: the sun paths are traced around the suns of the lit ones.
+    let groups = if shades.is_some() { scene.shades.len() } else { 0 };
+    if groups > 16 {
+        return Err(format!("{} shade groups: at most 16 are studied together", groups));
+    }
+    // Tracing the year's sun, when it falls to us, is most of the work.
+    let tracing_share = if options.sun_hours.is_some() { 0.0 } else { 0.95 };
+    let own_sun;
+    let sun_hours = match options.sun_hours {
+        Some(sun_hours) if !sun_hours.fits(model, site, shades.is_some()) => {
+            return Err("the year's sun was traced for another scene, site or shade study".into());
+        }
+        Some(sun_hours) => sun_hours,
+        None => {
+            own_sun = SunHours::trace(model, coefficients, site, shades.is_some(), None, &|done| progress(tracing_share * done));
+            &own_sun
+        }
+    };
     let skies: Vec<Result<Option<Sky>, SkyError>> = par_map(None, HOURS, |k| {
         let hour = &weather.hours[k];
         hour_sky(site, &hour_time(hour.month, hour.day, hour.hour), hour.direct_normal, hour.diffuse_horizontal)
     });
     let lit = |k: usize| skies[k].as_ref().ok().and_then(Option::as_ref);
-    let suns = |hours: &mut dyn Iterator<Item = usize>| -> Vec<DVec3> { hours.filter_map(|k| lit(k)?.sun).map(|s| s.direction).collect() };
 
     // Which shade groups are down in each hour (a bit per group), and the
-    // light with each combination that occurs.
-    let groups = if shades.is_some() { scene.shades.len() } else { 0 };
-    if groups > 16 {
-        return Err(format!("{} shade groups: at most 16 are studied together", groups));
-    }
+    // light with each combination that occurs: a model, its coefficients
+    // and its sun path around the suns of the hours it reads.
     let down: Vec<u32> = par_map(None, HOURS, |k| match lit(k) {
-        Some(sky) if groups > 0 && occupancy.contains(weather.hours[k].hour) => shades_down(model, sky),
+        Some(sky) if groups > 0 && occupancy.contains(weather.hours[k].hour) => shades_down(model, sun_hours, k, sky),
         _ => 0,
     });
-    // Each model's sun path around the suns of the hours it reads.
-    let sun_path = SunPath::new(model, coefficients, site, &suns(&mut (0..HOURS).filter(|&k| down[k] == 0)), None);
     let combinations: std::collections::BTreeSet<u32> = down.iter().copied().filter(|&m| m != 0).collect();
     let shaded_models: Vec<(u32, LightModel)> = combinations
         .into_iter()
@@ -308,7 +330,8 @@ pub fn annual(
         .iter()
         .map(|(mask, model)| {
             let coefficients = model.sensor_coefficients();
-            let path = SunPath::new(model, &coefficients, site, &suns(&mut (0..HOURS).filter(|&k| down[k] == *mask)), None);
+            let suns: Vec<DVec3> = (0..HOURS).filter(|&k| down[k] == *mask).filter_map(|k| lit(k)?.sun).map(|s| s.direction).collect();
+            let path = SunPath::new(model, &coefficients, site, &suns, None);
             (*mask, model, coefficients, path)
         })
         .collect();
@@ -327,13 +350,13 @@ pub fn annual(
             tally.skipped += usize::from(skies[k].is_err());
             // (total with the hour's shades, direct sun with every shade up) per sensor.
             let readings: Option<Vec<(f64, f64)>> = lit(k).map(|sky| {
+                let open = coefficients.readings_with_sun(model, sky, sun_hours.response(k), Some(1));
                 match shaded.iter().find(|(mask, ..)| *mask == down[k]) {
-                    // With shades down only the direct sun is needed with them up (for ASE).
                     Some((_, shaded_model, coefficients, path)) => {
                         let lowered = coefficients.readings_on_path(shaded_model, sky, path, Some(1));
-                        lowered.iter().zip(model.sensors_direct_sun(sky, Some(1))).map(|(l, sun)| (l.total, sun)).collect()
+                        lowered.iter().zip(&open).map(|(l, o)| (l.total, o.direct_sun)).collect()
                     }
-                    None => coefficients.readings_on_path(model, sky, &sun_path, Some(1)).iter().map(|r| (r.total, r.direct_sun)).collect(),
+                    None => open.iter().map(|r| (r.total, r.direct_sun)).collect(),
                 }
             });
             if occupancy.contains(hour.hour) {
@@ -344,7 +367,7 @@ pub fn annual(
             }
             if hour.hour == 24 {
                 let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                progress(finished as f64 / days as f64);
+                progress(tracing_share + (1.0 - tracing_share) * finished as f64 / days as f64);
             }
         }
         (tally, hourly)
@@ -370,27 +393,21 @@ pub fn annual(
     Ok(AnnualResult { sensors, occupied_hours, shaded_hours: tally.shaded, skipped_hours: tally.skipped, hourly })
 }
 
-/// The shade groups (a bit each) that LM-83 lowers under `sky`: more than
-/// 2% of the point sensors get at least [`ASE_LUX`] of direct sun through
-/// the group's windows.
-fn shades_down(model: &LightModel, sky: &Sky) -> u32 {
+/// The shade groups (a bit each) that LM-83 lowers in hour `k` under
+/// `sky`: more than 2% of the point sensors get at least [`ASE_LUX`] of
+/// direct sun through the group's windows.
+fn shades_down(model: &LightModel, sun_hours: &SunHours, k: usize, sky: &Sky) -> u32 {
     let scene = &model.scene;
     let Some(sun) = sky.sun.filter(|s| s.direction.z > 0.0) else { return 0 };
-    let beams = model.sun_beams(&sun);
     let points: Vec<usize> = (0..scene.sensors.len()).filter(|&i| scene.sensors[i].size.is_none()).collect();
-    let mut sunny = vec![0usize; scene.shades.len()];
-    for &i in &points {
-        let by_window = model.sensor_sun_by_window(i, &beams);
-        for (g, group) in scene.shades.iter().enumerate() {
-            let through: f64 = by_window
-                .iter()
-                .filter(|(w, _)| w.is_some_and(|w| scene.windows[w as usize].material == group.windows))
-                .map(|(_, e)| e)
-                .sum();
-            sunny[g] += usize::from(through * LUMINOUS_EFFICACY >= ASE_LUX);
-        }
-    }
-    sunny.iter().enumerate().filter(|&(_, &n)| n as f64 > SHADE_SENSOR_SHARE * points.len() as f64).fold(0, |mask, (g, _)| mask | 1 << g)
+    (0..scene.shades.len())
+        .filter(|&g| {
+            let through = sun_hours.through_shade(k, g);
+            let sunny =
+                points.iter().filter(|&&i| through.get(i).is_some_and(|&e| sun.normal_irradiance() * f64::from(e) >= ASE_LUX)).count();
+            sunny as f64 > SHADE_SENSOR_SHARE * points.len() as f64
+        })
+        .fold(0, |mask, g| mask | 1 << g)
 }
 
 #[cfg(test)]
