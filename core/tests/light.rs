@@ -629,3 +629,61 @@ fn the_years_sun_is_cached_and_a_warm_year_reads_what_a_traced_one_does() {
     assert_ne!(SunHours::key(&repainted, &site, false), SunHours::key(&model, &site, false), "reflectances are in the key");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 15's hourly bound: every hour of the annual path (the year's sun
+/// table, the sun path, the sensor coefficients) reads what `sensors`
+/// (`LightModel::solve`) reads at the hour's middle within 2%, at every
+/// sensor, over hours spread across the year and the day, on the office
+/// and the test room.
+#[test]
+fn annual_hours_read_what_sensors_reads_within_2_percent() {
+    use heliodon_core::annual::{AnnualOptions, annual, hour_time};
+    use heliodon_core::weather::{HOURS, Station, Weather, WeatherHour, calendar};
+    for name in ["office", "test_room"] {
+        let scene = load(&heliodon_core::bundled_scene(name));
+        let site = scene.site;
+        let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
+        // A clear sun every hour; occupancy all day so every hour is kept.
+        let (direct_normal, diffuse_horizontal) = (700.0, 120.0);
+        let hours = (0..HOURS).map(calendar).map(|(month, day, hour)| WeatherHour {
+            month,
+            day,
+            hour,
+            direct_normal,
+            diffuse_horizontal,
+            missing: false,
+        });
+        let station =
+            Station { name: "clear".into(), latitude: site.latitude, longitude: site.longitude, timezone: site.timezone, elevation: 0.0 };
+        let weather = Weather { station, hours: hours.collect() };
+        let options = AnnualOptions { keep_hourly: true, ..Default::default() };
+        let year = annual(&model, &site, &weather, &options, &|_| {}).unwrap();
+        let hourly = year.hourly.unwrap();
+        let perez = SkySpec::Perez(heliodon_core::sky::perez::Input::Irradiance { direct_normal, diffuse_horizontal });
+        let mut errors = Vec::new();
+        for month in 1..=12 {
+            for hour in 8..=17 {
+                let day = 9 + month;
+                let k = (0..HOURS).find(|&k| calendar(k) == (month, day, hour)).unwrap();
+                let (_, sky) = heliodon_core::sky::sky_at(&site, &perez, &hour_time(month, day, hour));
+                let Ok(sky) = sky else { continue };
+                if !sky.sun.is_some_and(|s| s.direction.z > 0.0) {
+                    continue;
+                }
+                for (reading, &read) in model.solve(&sky, None).sensors.iter().zip(&hourly[k]) {
+                    let error = (f64::from(read) - reading.total).abs() / reading.total;
+                    errors.push(error);
+                    assert!(
+                        error <= 0.02,
+                        "{name} {month}/{day} hour {hour}, {}: annual {read} against sensors {}",
+                        reading.name,
+                        reading.total
+                    );
+                }
+            }
+        }
+        errors.sort_by(f64::total_cmp);
+        assert!(errors.len() > 1000, "{name}: {} readings", errors.len());
+        assert!(errors[errors.len() / 2] < 0.003, "{name}: median {}", errors[errors.len() / 2]);
+    }
+}

@@ -8,7 +8,12 @@ pub struct LightSettings {
     pub rays_per_patch: usize,
     /// Hemisphere rays from each sensor point.
     pub rays_per_sensor: usize,
-    /// Shadow rays toward the sun per patch.
+    /// Shadow rays toward the sun per patch side. A sample toggles as a
+    /// shadow edge crosses it, so the sun's bounced light moves in steps of
+    /// 1/n of a side's beam: at 64 an hour read between sun positions (the
+    /// annual sun path) stays within 2% of one traced at it, where 16 gave
+    /// 2.6% (the office); relights cost little more (enclosed sides are
+    /// mostly spared by the openings).
     pub sun_samples_per_patch: usize,
     /// Points per side of an area sensor's grid for the direct sun (sky and
     /// indirect use a 4 × 4 grid).
@@ -29,7 +34,7 @@ impl Default for LightSettings {
         Self {
             rays_per_patch: 256,
             rays_per_sensor: 4096,
-            sun_samples_per_patch: 16,
+            sun_samples_per_patch: 64,
             area_sensor_sun_grid: 32,
             sky_subdivision: 4,
             max_iterations: 200,
