@@ -106,8 +106,10 @@ impl fmt::Display for CliError {
 }
 
 /// Parses the command line and runs it; `panels` are the panel types every
-/// scene may name (registered in every app it makes).
+/// scene may name (registered in every app it makes). The process's entry:
+/// call it before starting any thread (it may set `XDG_RUNTIME_DIR`).
 pub fn main(panels: PanelCatalog) -> ExitCode {
+    give_a_private_runtime_dir();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(error) => {
@@ -150,6 +152,31 @@ pub fn main(panels: PanelCatalog) -> ExitCode {
         eprintln!("error: {error}");
         ExitCode::from(error.code)
     })
+}
+
+/// Mesa's Vulkan drivers print `error: XDG_RUNTIME_DIR is invalid or not
+/// set in the environment` (once per probe) when the variable is missing,
+/// though nothing is wrong and the run succeeds: without a usable one, this
+/// process gets a private folder of its own (0700, what `tools/test`
+/// does), so a successful run prints no error line.
+fn give_a_private_runtime_dir() {
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::unix::fs::{DirBuilderExt, MetadataExt, PermissionsExt};
+        if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|dir| std::path::Path::new(&dir).is_dir()) {
+            return;
+        }
+        let Ok(me) = std::fs::metadata("/proc/self").map(|m| m.uid()) else { return };
+        let dir = std::env::temp_dir().join(format!("heliodon-runtime-{me}"));
+        let _ = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+        // Only a folder that is ours and closed to others.
+        let ours = std::fs::symlink_metadata(&dir).is_ok_and(|m| m.is_dir() && m.uid() == me && m.permissions().mode() & 0o077 == 0);
+        if ours {
+            // SAFETY: `main` runs first in the process, before any thread
+            // that could read the environment is started.
+            unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+        }
+    }
 }
 
 #[cfg(test)]
