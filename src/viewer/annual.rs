@@ -170,14 +170,18 @@ fn update_annual(mut study: ResMut<AnnualStudy>, engine: Option<Res<LightEngine>
     study.done = done.clone();
     let (site, dir) = (site.0, cache_dir.0.clone());
     study.result.start(key, move || {
-        // Tracing the year's sun (once per scene and site: then from the cache) is most of the work.
-        const TRACING_SHARE: f64 = 0.95;
+        // Tracing the year's sun (once per scene and site: then from the
+        // cache) is most of the work; a table too big for memory is not
+        // made, and the year then traces hour by hour.
         let progress = move |share: f64| done.store((share * 365.0).round() as usize, Ordering::Relaxed);
         let coefficients = model.sensor_coefficients();
-        let (sun_hours, _) =
-            SunHours::cached(&model, &coefficients, &site, false, dir.as_deref(), &|share| progress(TRACING_SHARE * share))?;
-        let options = AnnualOptions { coefficients: Some(&coefficients), sun_hours: Some(&sun_hours), ..Default::default() };
-        annual(&model, &site, &weather, &options, &|share| progress(TRACING_SHARE + (1.0 - TRACING_SHARE) * share))
+        let tracing_share = if SunHours::fits_in_memory(&model, &site, false) { 0.95 } else { 0.0 };
+        let sun_hours = (tracing_share > 0.0)
+            .then(|| SunHours::cached(&model, &coefficients, &site, false, dir.as_deref(), &|share| progress(tracing_share * share)))
+            .transpose()?
+            .map(|(table, _)| table);
+        let options = AnnualOptions { coefficients: Some(&coefficients), sun_hours: sun_hours.as_ref(), ..Default::default() };
+        annual(&model, &site, &weather, &options, &|share| progress(tracing_share + (1.0 - tracing_share) * share))
     });
 }
 

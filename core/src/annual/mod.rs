@@ -23,9 +23,11 @@
 //!    radiances plus the table's row times the hour's direct normal
 //!    irradiance: no ray, no radiosity solve. Runs of whole days go in
 //!    parallel; hours are independent, so the numbers do not depend on the
-//!    thread count; occupied hours are counted as they come (memory follows
-//!    sensors × sun-up hours, not the weather, unless every hour is kept for
-//!    `--hourly`).
+//!    thread count; occupied hours are counted as they come. The table
+//!    holds sensors × sun-up hours (5.4 MB for the office's 150 sensors);
+//!    past [`MAX_TABLE_BYTES`] none is made and the sun is traced hour by
+//!    hour, so memory stays bounded by the sensors and threads (unless
+//!    every hour is kept for `--hourly`).
 //! 4. ASE counts the direct sun alone (no sky, no interreflection).
 //!
 //! 5. LM-83 operable shades (`[[shades]]`): in each occupied hour a group
@@ -36,7 +38,8 @@
 
 mod sun_hours;
 
-pub use sun_hours::SunHours;
+use sun_hours::YearSun;
+pub use sun_hours::{MAX_TABLE_BYTES, SunHours};
 
 use glam::DVec3;
 
@@ -293,17 +296,19 @@ pub fn annual(
         return Err(format!("{} shade groups: at most 16 are studied together", groups));
     }
     // Tracing the year's sun, when it falls to us, is most of the work.
-    let tracing_share = if options.sun_hours.is_some() { 0.0 } else { 0.95 };
-    let own_sun;
-    let sun_hours = match options.sun_hours {
-        Some(sun_hours) if !sun_hours.fits(model, site, shades.is_some()) => {
+    let make_table = options.sun_hours.is_none() && SunHours::fits_in_memory(model, site, shades.is_some());
+    let tracing_share = if make_table { 0.95 } else { 0.0 };
+    let own_table;
+    let year_sun = match options.sun_hours {
+        Some(table) if !table.fits(model, site, shades.is_some()) => {
             return Err("the year's sun was traced for another scene, site or shade study".into());
         }
-        Some(sun_hours) => sun_hours,
-        None => {
-            own_sun = SunHours::trace(model, coefficients, site, shades.is_some(), None, &|done| progress(tracing_share * done));
-            &own_sun
+        Some(table) => YearSun::Table(table),
+        None if make_table => {
+            own_table = SunHours::trace(model, coefficients, site, shades.is_some(), None, &|done| progress(tracing_share * done));
+            YearSun::Table(&own_table)
         }
+        None => YearSun::traced(model, coefficients, site, shades.is_some()),
     };
     let skies: Vec<Result<Option<Sky>, SkyError>> = par_map(None, HOURS, |k| {
         let hour = &weather.hours[k];
@@ -315,7 +320,9 @@ pub fn annual(
     // light with each combination that occurs: a model, its coefficients
     // and its sun path around the suns of the hours it reads.
     let down: Vec<u32> = par_map(None, HOURS, |k| match lit(k) {
-        Some(sky) if groups > 0 && occupancy.contains(weather.hours[k].hour) => shades_down(model, sun_hours, k, sky),
+        Some(sky) if groups > 0 && occupancy.contains(weather.hours[k].hour) => {
+            shades_down(model, year_sun.through_shades(k).as_deref(), sky)
+        }
         _ => 0,
     });
     let combinations: std::collections::BTreeSet<u32> = down.iter().copied().filter(|&m| m != 0).collect();
@@ -350,7 +357,7 @@ pub fn annual(
             tally.skipped += usize::from(skies[k].is_err());
             // (total with the hour's shades, direct sun with every shade up) per sensor.
             let readings: Option<Vec<(f64, f64)>> = lit(k).map(|sky| {
-                let open = coefficients.readings_with_sun(model, sky, sun_hours.response(k), Some(1));
+                let open = coefficients.readings_with_sun(model, sky, year_sun.response(k).as_deref(), Some(1));
                 match shaded.iter().find(|(mask, ..)| *mask == down[k]) {
                     Some((_, shaded_model, coefficients, path)) => {
                         let lowered = coefficients.readings_on_path(shaded_model, sky, path, Some(1));
@@ -393,18 +400,19 @@ pub fn annual(
     Ok(AnnualResult { sensors, occupied_hours, shaded_hours: tally.shaded, skipped_hours: tally.skipped, hourly })
 }
 
-/// The shade groups (a bit each) that LM-83 lowers in hour `k` under
-/// `sky`: more than 2% of the point sensors get at least [`ASE_LUX`] of
-/// direct sun through the group's windows.
-fn shades_down(model: &LightModel, sun_hours: &SunHours, k: usize, sky: &Sky) -> u32 {
+/// The shade groups (a bit each) that LM-83 lowers under `sky`, given the
+/// hour's direct sun through each group's windows per W/m² (`[group][sensor]`,
+/// `None` with the sun down): more than 2% of the point sensors get at
+/// least [`ASE_LUX`] of direct sun through the group's windows.
+fn shades_down(model: &LightModel, through_shades: Option<&[f32]>, sky: &Sky) -> u32 {
     let scene = &model.scene;
-    let Some(sun) = sky.sun.filter(|s| s.direction.z > 0.0) else { return 0 };
-    let points: Vec<usize> = (0..scene.sensors.len()).filter(|&i| scene.sensors[i].size.is_none()).collect();
+    let (Some(sun), Some(through_shades)) = (sky.sun.filter(|s| s.direction.z > 0.0), through_shades) else { return 0 };
+    let sensors = scene.sensors.len();
+    let points: Vec<usize> = (0..sensors).filter(|&i| scene.sensors[i].size.is_none()).collect();
     (0..scene.shades.len())
         .filter(|&g| {
-            let through = sun_hours.through_shade(k, g);
-            let sunny =
-                points.iter().filter(|&&i| through.get(i).is_some_and(|&e| sun.normal_irradiance() * f64::from(e) >= ASE_LUX)).count();
+            let through = &through_shades[g * sensors..(g + 1) * sensors];
+            let sunny = points.iter().filter(|&&i| sun.normal_irradiance() * f64::from(through[i]) >= ASE_LUX).count();
             sunny as f64 > SHADE_SENSOR_SHARE * points.len() as f64
         })
         .fold(0, |mask, g| mask | 1 << g)

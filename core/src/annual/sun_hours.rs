@@ -13,6 +13,7 @@
 //! material's light (reflectances, glass, panel keys), the site, the shade
 //! groups.
 
+use std::borrow::Cow;
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -30,6 +31,12 @@ use crate::weather::{HOURS, calendar};
 
 /// Bump when the table or how it is traced changes.
 const FORMAT: u32 = 1;
+
+/// The most a table may hold, bytes. Past it (a grid of tens of thousands
+/// of sensors) the year's sun is traced hour by hour instead
+/// ([`YearSun::Traced`]) and not cached: memory then follows the sensors
+/// and the threads, not the hours.
+pub const MAX_TABLE_BYTES: usize = 256 << 20;
 
 /// The sun's light at every sensor for each sun-up hour of the year.
 #[derive(Debug, Clone, PartialEq)]
@@ -149,10 +156,17 @@ impl SunHours {
         self.row(k).map(|row| &row.response)
     }
 
-    /// Hour `k`'s direct sun at every sensor through shade group `group`'s
-    /// windows, lux per W/m² (empty with the sun down).
-    pub fn through_shade(&self, k: usize, group: usize) -> &[f32] {
-        self.row(k).map_or(&[], |row| &row.through_shades[group * self.sensors..(group + 1) * self.sensors])
+    /// Hour `k`'s direct sun through each shade group's windows, lux per
+    /// W/m², `[group][sensor]`; `None` with the sun down.
+    pub fn through_shades(&self, k: usize) -> Option<&[f32]> {
+        self.row(k).map(|row| row.through_shades.as_slice())
+    }
+
+    /// Whether a table of `model` at `site` stays within [`MAX_TABLE_BYTES`].
+    pub fn fits_in_memory(model: &LightModel, site: &Site, shades: bool) -> bool {
+        let groups = if shades { model.scene.shades.len() } else { 0 };
+        let sun_up = par_map(None, HOURS, |k| sun_direction(site, k).is_some()).into_iter().filter(|&up| up).count();
+        model.scene.sensors.len() * (2 + groups) * sun_up * size_of::<f32>() <= MAX_TABLE_BYTES
     }
 
     fn row(&self, k: usize) -> Option<&SunHour> {
@@ -201,6 +215,51 @@ impl SunHours {
     }
 }
 
+/// Where a year's hours get their sun: a table, or traced hour by hour where
+/// a table would not fit in memory ([`SunHours::fits_in_memory`]).
+pub(super) enum YearSun<'a> {
+    Table(&'a SunHours),
+    Traced {
+        model: &'a LightModel,
+        coefficients: &'a SensorCoefficients,
+        site: &'a Site,
+        /// The sun's later bounces around every sun-up hour.
+        path: SunPath,
+        shade_groups: usize,
+    },
+}
+
+impl<'a> YearSun<'a> {
+    /// Hour by hour: the sun path of the year at `site`.
+    pub(super) fn traced(model: &'a LightModel, coefficients: &'a SensorCoefficients, site: &'a Site, shades: bool) -> Self {
+        let up: Vec<DVec3> = par_map(None, HOURS, |k| sun_direction(site, k)).into_iter().flatten().collect();
+        let path = SunPath::new(model, coefficients, site, &up, None);
+        let shade_groups = if shades { model.scene.shades.len() } else { 0 };
+        YearSun::Traced { model, coefficients, site, path, shade_groups }
+    }
+
+    /// Hour `k`'s response, `None` with the sun down.
+    pub(super) fn response(&self, k: usize) -> Option<Cow<'_, SunResponse>> {
+        match self {
+            YearSun::Table(table) => table.response(k).map(Cow::Borrowed),
+            YearSun::Traced { model, coefficients, site, path, .. } => {
+                sun_direction(site, k).map(|sun| Cow::Owned(coefficients.sun_response(model, sun, path, Some(1))))
+            }
+        }
+    }
+
+    /// Hour `k`'s direct sun through each shade group's windows
+    /// ([`SunHours::through_shades`]), `None` with the sun down.
+    pub(super) fn through_shades(&self, k: usize) -> Option<Cow<'_, [f32]>> {
+        match self {
+            YearSun::Table(table) => table.through_shades(k).map(Cow::Borrowed),
+            YearSun::Traced { model, site, shade_groups, .. } => {
+                sun_direction(site, k).map(|sun| Cow::Owned(through_shades(model, sun, *shade_groups)))
+            }
+        }
+    }
+}
+
 /// The sun's direction in the model's frame at the middle of hour `k` of the
 /// 365-day year, as [`super::hour_sky`]'s sky places it; `None` when down.
 fn sun_direction(site: &Site, k: usize) -> Option<DVec3> {
@@ -230,4 +289,33 @@ fn through_shades(model: &LightModel, direction: DVec3, groups: usize) -> Vec<f3
         }
     }
     through
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use super::*;
+    use crate::light::LightSettings;
+    use crate::panel::PanelCatalog;
+
+    /// Traced hour by hour (a table too big for memory) the year's sun is
+    /// the table's, hour for hour.
+    #[test]
+    fn hours_traced_one_by_one_are_the_tables() {
+        let scene = crate::scene::load_scene(&crate::bundled_scene("test_room"), &PanelCatalog::new()).unwrap().scene;
+        let site = scene.site;
+        let model = LightModel::precompute(Arc::new(scene), LightSettings::default()).unwrap();
+        let coefficients = model.sensor_coefficients();
+        let table = SunHours::trace(&model, &coefficients, &site, false, None, &|_| {});
+        assert!(SunHours::fits_in_memory(&model, &site, false));
+        let traced = YearSun::traced(&model, &coefficients, &site, false);
+        let mut lit = 0;
+        for k in (0..HOURS).step_by(97) {
+            let (from_table, one_by_one) = (table.response(k), traced.response(k));
+            assert_eq!(from_table, one_by_one.as_deref(), "hour {k}");
+            lit += usize::from(from_table.is_some_and(|r| r.direct.iter().any(|&e| e > 0.0)));
+        }
+        assert!(lit > 10, "{lit} sunny hours compared");
+    }
 }

@@ -74,20 +74,26 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     let shaded = |down: &[usize]| precompute_for_command(std::sync::Arc::new(scene.with_shades_down(down)), args.no_cache);
     let shades: Option<ShadedModel> = (!scene.shades.is_empty() && !args.no_shades).then_some(&shaded);
     let coefficients = model.sensor_coefficients();
-    // The year's sun at the site: traced once, then from the cache for every weather file.
-    let tracing = progress_bar("tracing the year's sun");
-    let cache_dir = if args.no_cache { None } else { cache::default_dir() };
-    let (sun_hours, _) = SunHours::cached(&model, &coefficients, site, shades.is_some(), cache_dir.as_deref(), &|done| {
-        tracing.set_position((done * 1000.0) as u64)
-    })?;
-    tracing.finish_and_clear();
+    // The year's sun at the site: traced once, then from the cache for every
+    // weather file (unless its table would not fit in memory: then hour by hour).
+    let sun_hours = if SunHours::fits_in_memory(&model, site, shades.is_some()) {
+        let tracing = progress_bar("tracing the year's sun");
+        let cache_dir = if args.no_cache { None } else { cache::default_dir() };
+        let (sun_hours, _) = SunHours::cached(&model, &coefficients, site, shades.is_some(), cache_dir.as_deref(), &|done| {
+            tracing.set_position((done * 1000.0) as u64)
+        })?;
+        tracing.finish_and_clear();
+        Some(sun_hours)
+    } else {
+        None
+    };
     let progress = progress_bar("a year of hours");
     let options = AnnualOptions {
         occupancy: args.occupied,
         shades,
         keep_hourly: args.hourly.is_some(),
         coefficients: Some(&coefficients),
-        sun_hours: Some(&sun_hours),
+        sun_hours: sun_hours.as_ref(),
     };
     let result = annual(&model, site, &weather, &options, &|done| progress.set_position((done * 1000.0) as u64));
     progress.finish_and_clear();
