@@ -47,6 +47,16 @@ fn test_room_with(folder: &str, extra: &str) -> PathBuf {
     dir.join("scene.toml")
 }
 
+/// A folder `folder` under the test target's temporary folder holding a
+/// synthetic year of weather; (the folder, the EPW's path).
+fn folder_with_a_year(folder: &str) -> (PathBuf, PathBuf) {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(folder);
+    std::fs::create_dir_all(&dir).unwrap();
+    let epw = dir.join("boston.epw");
+    std::fs::write(&epw, boston_epw(8760)).unwrap();
+    (dir, epw)
+}
+
 fn load(path: &Path) -> Arc<Scene> {
     Arc::new(load_scene(path, &PanelCatalog::new()).unwrap().scene)
 }
@@ -387,10 +397,7 @@ fn export_radiance_writes_the_same_model_and_sky() {
 /// occupied hours that file shows.
 #[test]
 fn annual_hours_are_perez_skies_and_the_metrics_count_them() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("annual");
-    std::fs::create_dir_all(&dir).unwrap();
-    let epw = dir.join("boston.epw");
-    std::fs::write(&epw, boston_epw(8760)).unwrap();
+    let (dir, epw) = folder_with_a_year("annual");
     let hourly = dir.join("hourly.csv");
     let room = bundled_scene("test_room");
     let args =
@@ -479,10 +486,7 @@ fn annual_refuses_bad_weather_and_scenes_without_sensors_in_one_line() {
 /// less light, and ASE is counted with every shade up.
 #[test]
 fn annual_lowers_operable_shades_hour_by_hour() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("annual_lm83");
-    std::fs::create_dir_all(&dir).unwrap();
-    let epw = dir.join("boston.epw");
-    std::fs::write(&epw, boston_epw(8760)).unwrap();
+    let (dir, epw) = folder_with_a_year("annual_lm83");
     let shades = "\n[materials.blinds]\nkind = \"glass\"\ntransmittance = 0.1\n\n[[shades]]\nwindows = \"glass\"\nshade = \"blinds\"\n";
     let scene = test_room_with("annual_lm83", shades);
     let year = |extra: &[&str], hourly: &Path| {
@@ -716,10 +720,7 @@ fn sweeps_read_what_scene_files_with_those_keys_read() {
 /// file with those keys; the picture is written.
 #[test]
 fn sweeps_against_a_year_read_what_annual_reads() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sweep_year");
-    std::fs::create_dir_all(&dir).unwrap();
-    let epw = dir.join("boston.epw");
-    std::fs::write(&epw, boston_epw(8760)).unwrap();
+    let (dir, epw) = folder_with_a_year("sweep_year");
     let picture = dir.join("curve.png");
     let room = bundled_scene("prismatic_room");
     let args = ["sweep", room.to_str().unwrap(), "--material", "upper", "--vary", "facet_angles[0]=30..50:20", "--all-sensors"];

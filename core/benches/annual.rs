@@ -36,8 +36,8 @@ fn scenes() -> Vec<(&'static str, Arc<Scene>)> {
 fn year(model: &LightModel, weather: &Weather, cache: Option<&Path>) -> f64 {
     let site = &model.scene.site;
     let coefficients = model.sensor_coefficients();
-    let (sun_hours, _) = SunHours::cached(model, &coefficients, site, false, cache, &|_| {}).unwrap();
-    let options = AnnualOptions { coefficients: Some(&coefficients), sun_hours: Some(&sun_hours), ..Default::default() };
+    let sun_hours = SunHours::cached(model, &coefficients, site, false, cache, &|_| {}).unwrap().map(|(table, _)| table);
+    let options = AnnualOptions { coefficients: Some(&coefficients), sun_hours: sun_hours.as_ref(), ..Default::default() };
     annual(model, site, weather, &options, &|_| {}).unwrap().sda()
 }
 

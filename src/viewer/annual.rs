@@ -13,7 +13,7 @@ use bevy::prelude::*;
 
 use super::background::Background;
 use super::schedule::ViewerSystems;
-use crate::annual::{AnnualOptions, AnnualResult, SensorYear, SunHours, annual};
+use crate::annual::{AnnualOptions, AnnualResult, SUN_TRACING_SHARE, SensorYear, SunHours, annual};
 use crate::ecs::{ActiveScene, LightCacheDir, LightEngine, Site, SkyChoice, SolarTime};
 use crate::sky::{SkySpec, perez};
 use crate::weather::Weather;
@@ -175,11 +175,10 @@ fn update_annual(mut study: ResMut<AnnualStudy>, engine: Option<Res<LightEngine>
         // made, and the year then traces hour by hour.
         let progress = move |share: f64| done.store((share * 365.0).round() as usize, Ordering::Relaxed);
         let coefficients = model.sensor_coefficients();
-        let tracing_share = if SunHours::fits_in_memory(&model, &site, false) { 0.95 } else { 0.0 };
-        let sun_hours = (tracing_share > 0.0)
-            .then(|| SunHours::cached(&model, &coefficients, &site, false, dir.as_deref(), &|share| progress(tracing_share * share)))
-            .transpose()?
-            .map(|(table, _)| table);
+        let sun_hours =
+            SunHours::cached(&model, &coefficients, &site, false, dir.as_deref(), &|share| progress(SUN_TRACING_SHARE * share))?
+                .map(|(table, _)| table);
+        let tracing_share = if sun_hours.is_some() { SUN_TRACING_SHARE } else { 0.0 };
         let options = AnnualOptions { coefficients: Some(&coefficients), sun_hours: sun_hours.as_ref(), ..Default::default() };
         annual(&model, &site, &weather, &options, &|share| progress(tracing_share + (1.0 - tracing_share) * share))
     });

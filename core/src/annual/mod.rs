@@ -245,6 +245,10 @@ pub fn hour_sky(site: &Site, when: &LocalDateTime, direct_normal: f64, diffuse_h
 /// [`crate::scene::Scene::with_shades_down`] draws it.
 pub type ShadedModel<'a> = &'a (dyn Fn(&[usize]) -> Result<LightModel, String> + Sync);
 
+/// The share of a year's progress given to tracing its sun, when a run
+/// makes the table (most of the work; the hours are the rest).
+pub const SUN_TRACING_SHARE: f64 = 0.95;
+
 /// LM-83's rule: a shade group goes down when more than this share of the
 /// point sensors get [`ASE_LUX`] or more of direct sun through its windows.
 const SHADE_SENSOR_SHARE: f64 = 0.02;
@@ -296,20 +300,21 @@ pub fn annual(
         return Err(format!("{} shade groups: at most 16 are studied together", groups));
     }
     // Tracing the year's sun, when it falls to us, is most of the work.
-    let make_table = options.sun_hours.is_none() && SunHours::fits_in_memory(model, site, shades.is_some());
-    let tracing_share = if make_table { 0.95 } else { 0.0 };
     let own_table;
     let year_sun = match options.sun_hours {
         Some(table) if !table.fits(model, site, shades.is_some()) => {
             return Err("the year's sun was traced for another scene, site or shade study".into());
         }
         Some(table) => YearSun::Table(table),
-        None if make_table => {
-            own_table = SunHours::trace(model, coefficients, site, shades.is_some(), None, &|done| progress(tracing_share * done));
-            YearSun::Table(&own_table)
-        }
-        None => YearSun::traced(model, coefficients, site, shades.is_some()),
+        None => match SunHours::cached(model, coefficients, site, shades.is_some(), None, &|done| progress(SUN_TRACING_SHARE * done))? {
+            Some((table, _)) => {
+                own_table = table;
+                YearSun::Table(&own_table)
+            }
+            None => YearSun::traced(model, coefficients, site, shades.is_some()),
+        },
     };
+    let tracing_share = if options.sun_hours.is_none() && matches!(year_sun, YearSun::Table(_)) { SUN_TRACING_SHARE } else { 0.0 };
     let skies: Vec<Result<Option<Sky>, SkyError>> = par_map(None, HOURS, |k| {
         let hour = &weather.hours[k];
         hour_sky(site, &hour_time(hour.month, hour.day, hour.hour), hour.direct_normal, hour.diffuse_horizontal)

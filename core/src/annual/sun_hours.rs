@@ -98,7 +98,9 @@ impl SunHours {
         Self { key: Self::key(model, site, shades), sensors: model.scene.sensors.len(), shade_groups, row_of_hour, rows }
     }
 
-    /// [`Self::trace`] through the light cache in `dir` (none: traced each time).
+    /// [`Self::trace`] through the light cache in `dir` (none: traced each
+    /// time); `None` when the table would hold more than
+    /// [`MAX_TABLE_BYTES`] (the year then traces its sun hour by hour).
     pub fn cached(
         model: &LightModel,
         coefficients: &SensorCoefficients,
@@ -106,7 +108,10 @@ impl SunHours {
         shades: bool,
         dir: Option<&Path>,
         progress: &(dyn Fn(f64) + Sync),
-    ) -> Result<(Self, CacheOutcome), String> {
+    ) -> Result<Option<(Self, CacheOutcome)>, String> {
+        if !Self::fits_in_memory(model, site, shades) {
+            return Ok(None);
+        }
         let key = Self::key(model, site, shades);
         cache::through_cache(
             dir,
@@ -116,6 +121,7 @@ impl SunHours {
             || Ok(Self::trace(model, coefficients, site, shades, None, progress)),
             Self::write,
         )
+        .map(Some)
     }
 
     /// What the table depends on: the scene's precomputation
@@ -163,7 +169,7 @@ impl SunHours {
     }
 
     /// Whether a table of `model` at `site` stays within [`MAX_TABLE_BYTES`].
-    pub fn fits_in_memory(model: &LightModel, site: &Site, shades: bool) -> bool {
+    fn fits_in_memory(model: &LightModel, site: &Site, shades: bool) -> bool {
         let groups = if shades { model.scene.shades.len() } else { 0 };
         let sun_up = par_map(None, HOURS, |k| sun_direction(site, k).is_some()).into_iter().filter(|&up| up).count();
         model.scene.sensors.len() * (2 + groups) * sun_up * size_of::<f32>() <= MAX_TABLE_BYTES
@@ -277,7 +283,7 @@ fn through_shades(model: &LightModel, direction: DVec3, groups: usize) -> Vec<f3
     if groups == 0 {
         return through;
     }
-    let beams = model.sun_beams(&SunSource { direction, solid_angle: 1.0, radiance: 1.0 });
+    let beams = model.sun_beams(&SunSource::unit(direction));
     for i in 0..sensors {
         for (window, e) in model.sensor_sun_by_window(i, &beams) {
             let Some(window) = window else { continue };

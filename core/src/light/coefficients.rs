@@ -247,7 +247,7 @@ impl SensorCoefficients {
     /// irradiance from `direction`: the beams and their first bounce traced,
     /// the later bounces from `path`.
     pub fn sun_response(&self, model: &LightModel, direction: DVec3, path: &SunPath, threads: Option<usize>) -> SunResponse {
-        let beams = model.sun_beams(&SunSource { direction, solid_angle: 1.0, radiance: 1.0 });
+        let beams = model.sun_beams(&SunSource::unit(direction));
         let reach = model.sides_reach(&beams, Some(&self.seen), threads);
         let first = self.first_bounce(model, &beams, &reach, threads);
         let direct = par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, &beams) * LUMINOUS_EFFICACY) as f32);
@@ -340,7 +340,7 @@ impl SunPath {
             suns.iter().flat_map(|&sun| path.cell(sun).0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
         let values = par_map(threads, needed.len(), |k| {
             let direction = path.direction(needed[k]);
-            let sun = SunSource { direction, solid_angle: 1.0, radiance: 1.0 };
+            let sun = SunSource::unit(direction);
             let beams = model.sun_beams(&sun);
             let mut lux = vec![0.0; model.sensors.len()];
             add_products(&mut lux, coefficients.later_bounces(&model.sun_on_sides(&beams, Some(&coefficients.seen), Some(1)).irradiance));

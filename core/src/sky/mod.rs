@@ -198,6 +198,12 @@ pub struct SunSource {
 }
 
 impl SunSource {
+    /// A sun of 1 W/m² normal irradiance from `direction`: light is linear
+    /// in the sun's strength, so responses to it scale to any hour's sun.
+    pub fn unit(direction: DVec3) -> Self {
+        Self { direction, solid_angle: 1.0, radiance: 1.0 }
+    }
+
     /// Irradiance on a plane facing the sun, W/m².
     pub fn normal_irradiance(&self) -> f64 {
         self.radiance * self.solid_angle

@@ -76,17 +76,13 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     let coefficients = model.sensor_coefficients();
     // The year's sun at the site: traced once, then from the cache for every
     // weather file (unless its table would not fit in memory: then hour by hour).
-    let sun_hours = if SunHours::fits_in_memory(&model, site, shades.is_some()) {
-        let tracing = progress_bar("tracing the year's sun");
-        let cache_dir = if args.no_cache { None } else { cache::default_dir() };
-        let (sun_hours, _) = SunHours::cached(&model, &coefficients, site, shades.is_some(), cache_dir.as_deref(), &|done| {
-            tracing.set_position((done * 1000.0) as u64)
-        })?;
-        tracing.finish_and_clear();
-        Some(sun_hours)
-    } else {
-        None
-    };
+    let tracing = progress_bar("tracing the year's sun");
+    let cache_dir = if args.no_cache { None } else { cache::default_dir() };
+    let sun_hours = SunHours::cached(&model, &coefficients, site, shades.is_some(), cache_dir.as_deref(), &|done| {
+        tracing.set_position((done * 1000.0) as u64)
+    })?
+    .map(|(table, _)| table);
+    tracing.finish_and_clear();
     let progress = progress_bar("a year of hours");
     let options = AnnualOptions {
         occupancy: args.occupied,
