@@ -138,3 +138,40 @@ fn the_viewer_runs_the_year_of_a_weather_file() {
         .count();
     assert!(lit > 1000, "{lit} lit pixels of the view");
 }
+
+/// Starts `$0 view $1` and samples its CPU time (user + system, ticks of
+/// 1/100 s) every 2 s for up to 3 minutes; succeeds after three samples in
+/// a row under 5 ticks (2.5% of a core), fails if it never rests.
+const IDLE_SAMPLER: &str = r#"
+"$0" view "$1" & viewer=$!
+ticks() { awk '{ print $14 + $15 }' /proc/$viewer/stat; }
+before=$(ticks); quiet=0
+for _ in $(seq 90); do
+    sleep 2
+    now=$(ticks) || exit 1
+    echo "$((now - before))"
+    if [ $((now - before)) -lt 5 ]; then quiet=$((quiet + 1)); else quiet=0; fi
+    before=$now
+    if [ $quiet -ge 3 ]; then kill $viewer; exit 0; fi
+done
+kill $viewer; exit 1
+"#;
+
+/// An interactive viewer left alone, once its light has settled, draws
+/// nothing: its CPU time stops growing (on lavapipe it kept 1.7 cores busy
+/// before it drew only on change).
+#[test]
+fn an_idle_viewer_rests() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viewer_idle");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes/test_room/scene.toml");
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1280x800x24", "sh", "-c", IDLE_SAMPLER, env!("CARGO_BIN_EXE_heliodon")])
+        .arg(&scene)
+        .env("HELIODON_CACHE_DIR", dir.join("cache"))
+        .output()
+        .expect("xvfb-run (tools/system-deps installs it)");
+    let samples = String::from_utf8_lossy(&out.stdout).split_whitespace().collect::<Vec<_>>().join(" ");
+    println!("viewer CPU ticks per 2 s: {samples}");
+    assert!(out.status.success(), "the viewer never rested; CPU ticks per 2 s: {samples}\n{}", String::from_utf8_lossy(&out.stderr));
+}

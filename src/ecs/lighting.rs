@@ -69,6 +69,14 @@ impl LightEngine {
     pub fn generation(&self) -> u64 {
         self.generation.load(Ordering::SeqCst)
     }
+
+    /// Whether the light is still on its way to `state`: precomputing, a
+    /// relight asked for, or the newest relight not yet shown converged.
+    pub fn is_settling(&self, state: &LightingState) -> bool {
+        self.is_precomputing()
+            || self.relight_pending
+            || (self.results.is_some() && !(state.converged && state.generation == self.generation()))
+    }
 }
 
 struct RelightResult {

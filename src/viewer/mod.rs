@@ -9,12 +9,13 @@
 //!   background and the sensors coloured by a metric ([`annual`]),
 //! - sweeps of a window material's keys, applied by a click ([`sweep`]),
 //! - panel lobes ([`lobes`]), saving the view ([`capture`]),
+//! - drawing only when something changes ([`redraw`]),
 //! - the batch flow of `view --screenshot/--hdr/--sensor` ([`batch`]).
 //!
 //! The modules form a one-way graph: `schedule` (the system sets),
 //! `focus`, `widgets` and `background` are leaves;
-//! `camera`, `capture`, `sensors`, `annual`, `sweep` and `lobes` read them; `ui`
-//! and `batch` read everything and nothing imports `ui`.
+//! `camera`, `capture`, `sensors`, `annual`, `sweep` and `lobes` read them; `ui`,
+//! `batch` and `redraw` read everything and nothing imports them.
 
 pub mod annual;
 pub mod background;
@@ -23,6 +24,7 @@ pub mod camera;
 pub mod capture;
 pub mod focus;
 pub mod lobes;
+pub mod redraw;
 pub mod schedule;
 pub mod sensors;
 pub mod sweep;
@@ -88,6 +90,7 @@ impl Plugin for ViewerPlugin {
             sweep::SweepPlugin,
             lobes::LobesPlugin,
             batch::BatchPlugin,
+            redraw::RedrawPlugin,
         ));
     }
 }

@@ -24,7 +24,6 @@ pub mod view;
 
 use bevy::camera::visibility::RenderLayers;
 use bevy::camera::{CameraOutputMode, Viewport};
-use bevy::diagnostic::FrameTimeDiagnosticsPlugin;
 use bevy::prelude::*;
 use bevy::render::render_resource::BlendState;
 use bevy::window::PrimaryWindow;
@@ -47,9 +46,6 @@ pub struct DesignerUiPlugin;
 
 impl Plugin for DesignerUiPlugin {
     fn build(&self, app: &mut App) {
-        if !app.is_plugin_added::<FrameTimeDiagnosticsPlugin>() {
-            app.add_plugins(FrameTimeDiagnosticsPlugin::default());
-        }
         app.add_plugins(EguiPlugin::default())
             .init_resource::<PlayDay>()
             .init_resource::<MaterialEdits>()

@@ -5,6 +5,7 @@
 
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
+use bevy::window::RequestRedraw;
 use bevy_egui::egui::{self, Ui};
 
 use crate::ecs::{ActiveScene, Site, SkyChoice, SolarTime, SunSky};
@@ -31,9 +32,10 @@ pub struct SunAndSkyPanel<'w> {
     play: ResMut<'w, PlayDay>,
 }
 
-/// Moves the clock while the day plays.
-pub fn play_the_day(time: Res<Time>, play: Res<PlayDay>, mut solar: ResMut<SolarTime>) {
+/// Moves the clock while the day plays (and asks for the next frame).
+pub fn play_the_day(time: Res<Time>, play: Res<PlayDay>, mut solar: ResMut<SolarTime>, mut redraw: MessageWriter<RequestRedraw>) {
     let Some(speed) = play.0 else { return };
+    redraw.write(RequestRedraw);
     let mut hours = solar.0.time.hours() + speed * f64::from(time.delta_secs());
     let mut date = solar.0.date;
     if hours >= 24.0 {

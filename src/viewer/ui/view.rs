@@ -1,7 +1,6 @@
 //! The view panel: the render mode (with the false-colour scale), the
 //! light's progress, the frame time, and saving the view.
 
-use bevy::diagnostic::{DiagnosticsStore, FrameTimeDiagnosticsPlugin};
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy_egui::egui::{self, Ui};
@@ -9,6 +8,7 @@ use bevy_egui::egui::{self, Ui};
 use crate::ecs::{LightEngine, LightingState};
 use crate::render::{RenderMode, RenderSettings};
 use crate::viewer::capture::{ImageFormat, SaveRequest};
+use crate::viewer::redraw::DrawnFrameTimes;
 use crate::viewer::widgets::bounded;
 
 /// What the view panel reads and writes (the render settings come from the
@@ -17,18 +17,15 @@ use crate::viewer::widgets::bounded;
 pub struct ViewPanel<'w> {
     lighting: Option<Res<'w, LightingState>>,
     engine: Option<Res<'w, LightEngine>>,
-    diagnostics: Res<'w, DiagnosticsStore>,
+    frame_times: Res<'w, DrawnFrameTimes>,
     save: ResMut<'w, SaveRequest>,
 }
 
 impl ViewPanel<'_> {
     /// Draws the panel.
     pub fn show(&mut self, ui: &mut Ui, settings: &mut ResMut<RenderSettings>, note: &mut Option<String>) {
-        // Frame time, smoothed and the worst of the recent history (ms).
-        let frame_time = self
-            .diagnostics
-            .get(&FrameTimeDiagnosticsPlugin::FRAME_TIME)
-            .and_then(|d| Some((d.smoothed()?, d.values().copied().fold(0.0, f64::max))));
+        // Frame time while drawing, and the worst of the recent history (ms).
+        let frame_time = self.frame_times.mean_and_worst();
         view_panel(ui, note, &mut self.save, settings, self.lighting.as_deref(), self.engine.as_deref(), frame_time);
     }
 }
