@@ -87,6 +87,8 @@ pub struct ActiveScene {
     /// The loaded scene, once there is one.
     pub scene: Option<Arc<Scene>>,
     pub root: Option<Entity>,
+    /// The file it was opened from.
+    pub path: Option<PathBuf>,
     pending: Option<(PathBuf, Handle<SceneAsset>)>,
 }
 
@@ -168,9 +170,9 @@ fn spawn_loaded_scene(
     }
     let root = spawn_scene(&mut commands, &scene);
     commands.insert_resource(Site(scene.site));
+    active.path = active.pending.take().map(|(path, _)| path);
     active.scene = Some(scene);
     active.root = Some(root);
-    active.pending = None;
     spawned.write(SceneSpawned { root, edited: false });
 }
 
