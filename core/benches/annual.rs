@@ -34,11 +34,7 @@ fn scenes() -> Vec<(&'static str, Arc<Scene>)> {
 }
 
 fn year(model: &LightModel, weather: &Weather, cache: Option<&Path>) -> f64 {
-    let site = &model.scene.site;
-    let coefficients = model.sensor_coefficients();
-    let sun_hours = SunHours::cached(model, &coefficients, site, false, cache, &|_| {}).unwrap().map(|(table, _)| table);
-    let options = AnnualOptions { coefficients: Some(&coefficients), sun_hours: sun_hours.as_ref(), ..Default::default() };
-    annual(model, site, weather, &options, &|_| {}).unwrap().sda()
+    annual(model, &model.scene.site, weather, &AnnualOptions { sun_cache: cache, ..Default::default() }, &|_| {}).unwrap().sda()
 }
 
 fn bench(c: &mut Criterion) {

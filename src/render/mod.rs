@@ -197,7 +197,7 @@ fn update_sun_pass(
         input.0 = None;
         return;
     };
-    let sun = sun_sky.sky.sun.filter(|s| s.direction.z > 0.0);
+    let sun = sun_sky.sky.sun_up();
     let Some(sun) = sun.filter(|_| settings.mode.draws_sun()) else {
         input.0 = None;
         return;
@@ -229,8 +229,7 @@ fn auto_exposure(
         let metered = if settings.mode == RenderMode::Sun {
             sun_sky
                 .as_ref()
-                .and_then(|s| s.sky.sun)
-                .filter(|sun| sun.direction.z > 0.0)
+                .and_then(|s| s.sky.sun_up())
                 .map(|sun| MIDDLE_GREY / std::f64::consts::PI * sun.normal_irradiance() * crate::sky::LUMINOUS_EFFICACY)
         } else {
             match (&active.scene, state.as_ref().and_then(|s| s.lighting.as_ref()), engine.as_ref().and_then(|e| e.model.as_ref())) {

@@ -73,7 +73,7 @@ pub fn compare_direct_sun(request: &OffscreenRequest, picture: &Path) -> Result<
     let when = request.when.ok_or("the comparison needs a time")?;
     let spec = request.sky.clone().ok_or("the comparison needs a sky")?;
     let sky = sky_at(&scene.site, &spec, &when).1.map_err(|e| e.to_string())?;
-    let sun = sky.sun.filter(|s| s.direction.z > 0.0).ok_or("the sun is down")?;
+    let sun = sky.sun_up().ok_or("the sun is down")?;
     let view = request.view.clone().unwrap_or_else(|| super::initial_view(&scene, Some(&model)));
     let image = offscreen::render(request.clone())?;
     image.save_png(picture)?;

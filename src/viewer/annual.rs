@@ -13,7 +13,7 @@ use bevy::prelude::*;
 
 use super::background::Background;
 use super::schedule::ViewerSystems;
-use crate::annual::{AnnualOptions, AnnualResult, SUN_TRACING_SHARE, SensorYear, SunHours, annual};
+use crate::annual::{AnnualOptions, AnnualResult, SensorYear, annual};
 use crate::ecs::{ActiveScene, LightCacheDir, LightEngine, Site, SkyChoice, SolarTime};
 use crate::sky::{SkySpec, perez};
 use crate::weather::Weather;
@@ -170,17 +170,9 @@ fn update_annual(mut study: ResMut<AnnualStudy>, engine: Option<Res<LightEngine>
     study.done = done.clone();
     let (site, dir) = (site.0, cache_dir.0.clone());
     study.result.start(key, move || {
-        // Tracing the year's sun (once per scene and site: then from the
-        // cache) is most of the work; a table too big for memory is not
-        // made, and the year then traces hour by hour.
+        // The year's sun is traced once per scene and site, then read from the light cache.
         let progress = move |share: f64| done.store((share * 365.0).round() as usize, Ordering::Relaxed);
-        let coefficients = model.sensor_coefficients();
-        let sun_hours =
-            SunHours::cached(&model, &coefficients, &site, false, dir.as_deref(), &|share| progress(SUN_TRACING_SHARE * share))?
-                .map(|(table, _)| table);
-        let tracing_share = if sun_hours.is_some() { SUN_TRACING_SHARE } else { 0.0 };
-        let options = AnnualOptions { coefficients: Some(&coefficients), sun_hours: sun_hours.as_ref(), ..Default::default() };
-        annual(&model, &site, &weather, &options, &|share| progress(tracing_share + (1.0 - tracing_share) * share))
+        annual(&model, &site, &weather, &AnnualOptions { sun_cache: dir.as_deref(), ..Default::default() }, &progress)
     });
 }
 

@@ -55,7 +55,7 @@ pub fn draw_lobes(
 ) {
     let (Some(window), Some(scene), Some(model), Some(sun_sky)) = (shown.0, &active.scene, ray_model, sun_sky) else { return };
     let Some(window) = scene.windows.get(window) else { return };
-    let Some(sun) = sun_sky.sky.sun.filter(|s| s.direction.z > 0.0) else { return };
+    let Some(sun) = sun_sky.sky.sun_up() else { return };
     let Some(group) = model.0.panel_group_of_surface(window.surface) else { return };
     let centre = window.centroid;
     let to_sun = sun.direction.as_vec3();

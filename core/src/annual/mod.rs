@@ -267,9 +267,13 @@ pub struct AnnualOptions<'a> {
     /// (a sweep of panel keys keeps one set for every combination).
     pub coefficients: Option<&'a SensorCoefficients>,
     /// The year's sun on the model at the site, when the caller has it
-    /// (from the light cache: [`SunHours::cached`]); traced otherwise. With
-    /// shades studied it must keep the shade groups' sun.
+    /// ([`SunHours::cached`]); made by the run otherwise. With shades
+    /// studied it must keep the shade groups' sun.
     pub sun_hours: Option<&'a SunHours>,
+    /// Where the run keeps the year's sun it makes (the light cache
+    /// folder), so the next year of the same scene and site reads it;
+    /// `None`: traced for this run only.
+    pub sun_cache: Option<&'a std::path::Path>,
 }
 
 /// Runs the year. With `options.shades`, every occupied hour lowers the
@@ -306,7 +310,9 @@ pub fn annual(
             return Err("the year's sun was traced for another scene, site or shade study".into());
         }
         Some(table) => YearSun::Table(table),
-        None => match SunHours::cached(model, coefficients, site, shades.is_some(), None, &|done| progress(SUN_TRACING_SHARE * done))? {
+        None => match SunHours::cached(model, coefficients, site, shades.is_some(), options.sun_cache, &|done| {
+            progress(SUN_TRACING_SHARE * done)
+        })? {
             Some((table, _)) => {
                 own_table = table;
                 YearSun::Table(&own_table)
@@ -411,7 +417,7 @@ pub fn annual(
 /// least [`ASE_LUX`] of direct sun through the group's windows.
 fn shades_down(model: &LightModel, through_shades: Option<&[f32]>, sky: &Sky) -> u32 {
     let scene = &model.scene;
-    let (Some(sun), Some(through_shades)) = (sky.sun.filter(|s| s.direction.z > 0.0), through_shades) else { return 0 };
+    let (Some(sun), Some(through_shades)) = (sky.sun_up(), through_shades) else { return 0 };
     let sensors = scene.sensors.len();
     let points: Vec<usize> = (0..sensors).filter(|&i| scene.sensors[i].size.is_none()).collect();
     (0..scene.shades.len())

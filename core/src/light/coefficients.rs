@@ -210,7 +210,7 @@ impl SensorCoefficients {
     /// Every sensor's reading under `sky` (`threads` as [`par_map`]): equal
     /// to [`LightModel::solve`]'s up to its tolerance.
     pub fn readings(&self, model: &LightModel, sky: &Sky, threads: Option<usize>) -> Vec<SensorReading> {
-        let beams = sky.sun.filter(|s| s.direction.z > 0.0).map(|s| model.sun_beams(&s)).unwrap_or_default();
+        let beams = sky.sun_up().map(|s| model.sun_beams(&s)).unwrap_or_default();
         let direct = par_map(threads, model.sensors.len(), |i| model.sensor_direct_sun(i, &beams) * LUMINOUS_EFFICACY);
         self.read(model, sky, SunLux { direct, interreflected: self.interreflected_sun(model, &beams, threads) }, threads)
     }
@@ -219,7 +219,7 @@ impl SensorCoefficients {
     /// from a [`SunPath`] instead of traced; the direct sun and its first
     /// bounce where the sensors' rays land are still traced.
     pub fn readings_on_path(&self, model: &LightModel, sky: &Sky, path: &SunPath, threads: Option<usize>) -> Vec<SensorReading> {
-        let response = sky.sun.filter(|s| s.direction.z > 0.0).map(|s| self.sun_response(model, s.direction, path, threads));
+        let response = sky.sun_up().map(|s| self.sun_response(model, s.direction, path, threads));
         self.readings_with_sun(model, sky, response.as_ref(), threads)
     }
 
@@ -234,7 +234,7 @@ impl SensorCoefficients {
         threads: Option<usize>,
     ) -> Vec<SensorReading> {
         let count = model.sensors.len();
-        let normal_irradiance = sky.sun.filter(|s| s.direction.z > 0.0).map_or(0.0, |s| s.normal_irradiance());
+        let normal_irradiance = sky.sun_up().map_or(0.0, |s| s.normal_irradiance());
         let scaled = |per_unit: Option<&Vec<f32>>| match per_unit {
             Some(values) if normal_irradiance > 0.0 => values.iter().map(|&v| normal_irradiance * f64::from(v)).collect(),
             _ => vec![0.0; count],

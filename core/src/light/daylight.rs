@@ -123,7 +123,7 @@ impl LightModel {
     pub(super) fn key_radiance(&self, sky: &Sky) -> KeyRadiance {
         let mut bins = Vec::with_capacity(self.bin_count() as usize);
         self.sky_bins.integrate_sphere_into(sky, &mut bins);
-        let sun = sky.sun.filter(|s| s.direction.z > 0.0);
+        let sun = sky.sun_up();
         let panels = self.panel_groups.iter().map(|g| g.radiance_through(&self.sky_bins, &bins)).collect();
         let panel_sun = self.panel_groups.iter().map(|g| g.sun_diffuse_radiance(sun.as_ref())).collect();
         KeyRadiance { bin_count: self.bin_count(), bins, panels, panel_sun, window_panel: self.window_panels() }

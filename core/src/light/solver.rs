@@ -131,7 +131,7 @@ impl LightModel {
     /// the interreflection, and [`Relight::lighting`] reads the state at any time.
     pub fn relight(&self, sky: &Sky, warm: Option<&Lighting>) -> Relight<'_> {
         let patches = &self.scene.patches.patches;
-        let sun = sky.sun.filter(|s| s.direction.z > 0.0);
+        let sun = sky.sun_up();
         let seen = self.key_radiance(sky);
         let beams = sun.map(|s| self.sun_beams(&s)).unwrap_or_default();
         let sides_sun = self.sun_on_sides(&beams, None, self.settings.threads);

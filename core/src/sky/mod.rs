@@ -279,6 +279,11 @@ pub fn blend_weight(dz: f64) -> f64 {
 }
 
 impl Sky {
+    /// The sun, when the sky has one above the horizon: what sheds direct light.
+    pub fn sun_up(&self) -> Option<SunSource> {
+        self.sun.filter(|s| s.direction.z > 0.0)
+    }
+
     /// Evaluates a sky for a sun at `altitude` and `azimuth` (degrees,
     /// apparent altitude, azimuth clockwise from north). `day_of_year` enters
     /// the Perez sky's brightness (gendaylit's `-ang` uses 0).

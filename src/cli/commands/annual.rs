@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use crate::annual::{AnnualOptions, AnnualResult, Occupancy, ShadedModel, SunHours, annual, hour_time};
+use crate::annual::{AnnualOptions, AnnualResult, Occupancy, ShadedModel, annual, hour_time};
 use crate::cli::CliError;
 use crate::cli::args::{Format, load_for_command, precompute_for_command, progress_bar};
 use crate::light::cache;
@@ -73,23 +73,16 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     let model = precompute_for_command(scene.clone(), args.no_cache)?;
     let shaded = |down: &[usize]| precompute_for_command(std::sync::Arc::new(scene.with_shades_down(down)), args.no_cache);
     let shades: Option<ShadedModel> = (!scene.shades.is_empty() && !args.no_shades).then_some(&shaded);
-    let coefficients = model.sensor_coefficients();
     // The year's sun at the site: traced once, then from the cache for every
     // weather file (unless its table would not fit in memory: then hour by hour).
-    let tracing = progress_bar("tracing the year's sun");
     let cache_dir = if args.no_cache { None } else { cache::default_dir() };
-    let sun_hours = SunHours::cached(&model, &coefficients, site, shades.is_some(), cache_dir.as_deref(), &|done| {
-        tracing.set_position((done * 1000.0) as u64)
-    })?
-    .map(|(table, _)| table);
-    tracing.finish_and_clear();
-    let progress = progress_bar("a year of hours");
+    let progress = progress_bar("the year's sun, then a year of hours");
     let options = AnnualOptions {
         occupancy: args.occupied,
         shades,
         keep_hourly: args.hourly.is_some(),
-        coefficients: Some(&coefficients),
-        sun_hours: sun_hours.as_ref(),
+        sun_cache: cache_dir.as_deref(),
+        ..Default::default()
     };
     let result = annual(&model, site, &weather, &options, &|done| progress.set_position((done * 1000.0) as u64));
     progress.finish_and_clear();
