@@ -48,9 +48,11 @@ fn bench(c: &mut Criterion) {
         let gathered = start.elapsed();
         let coefficients = model.sensor_coefficients();
         let folded = start.elapsed() - gathered;
-        let sun_hours = SunHours::trace(&model, &coefficients, &scene.site, false, None, &|_| {});
+        let sun_dir = cache.join("sun-only");
+        let sun_hours = SunHours::cached(&model, &coefficients, &scene.site, false, &sun_dir, &|_| {});
         let traced = start.elapsed() - gathered - folded;
         drop((coefficients, sun_hours));
+        let _ = std::fs::remove_dir_all(&sun_dir);
         let sda = year(&model, &weather, None);
         let total = start.elapsed();
         println!(

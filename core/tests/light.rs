@@ -578,8 +578,9 @@ fn the_sun_path_reads_what_tracing_reads() {
 
 /// The year's sun ([`SunHours`]) goes into the light cache and comes back
 /// whole: the warm year equals the one `annual` traces itself, hour by hour
-/// and bit for bit. Another site or another reflectance is another table
-/// (another key), and `annual` refuses a table that does not fit.
+/// and bit for bit; a damaged file is traced again. Another site or another
+/// reflectance is another table (another key), and `annual` refuses a table
+/// that does not fit.
 #[test]
 fn the_years_sun_is_cached_and_a_warm_year_reads_what_a_traced_one_does() {
     use heliodon_core::annual::{AnnualOptions, SunHours, annual};
@@ -593,13 +594,27 @@ fn the_years_sun_is_cached_and_a_warm_year_reads_what_a_traced_one_does() {
     let dir = std::env::temp_dir().join(format!("heliodon-sun-hours-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let cached = |model: &LightModel, site: &heliodon_core::site::Site| {
-        SunHours::cached(model, &coefficients, site, false, Some(&dir), &|_| {}).unwrap().expect("a table of 19 sensors fits in memory")
+        SunHours::cached(model, &coefficients, site, false, &dir, &|_| {}).expect("a table of 19 sensors is kept")
     };
     let (cold, outcome) = cached(&model, &site);
     assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");
     let (warm, outcome) = cached(&model, &site);
     assert!(matches!(outcome, CacheOutcome::Hit(_)), "{outcome:?}");
-    assert_eq!(cold, warm);
+    let CacheOutcome::Hit(path) = outcome else { unreachable!() };
+    let year = |table: &SunHours| (0..HOURS).map(|k| table.response(k).unwrap()).collect::<Vec<_>>();
+    let first = year(&cold);
+    assert_eq!(year(&warm), first);
+    // A damaged table is traced again, never trusted: a flipped byte, a truncation.
+    let good = std::fs::read(&path).unwrap();
+    let mut flipped = good.clone();
+    let last = flipped.len() - 3;
+    flipped[last] ^= 0x40;
+    for (damage, why) in [(flipped, "checksum mismatch"), (good[..good.len() / 2].to_vec(), "truncated")] {
+        std::fs::write(&path, damage).unwrap();
+        let (rebuilt, outcome) = cached(&model, &site);
+        assert_eq!(outcome, CacheOutcome::Rebuilt(path.clone(), why.to_string()));
+        assert_eq!(year(&rebuilt), first);
+    }
 
     // Sunny every third day, overcast otherwise.
     let hours = (0..HOURS)

@@ -24,10 +24,12 @@
 //!    irradiance: no ray, no radiosity solve. Runs of whole days go in
 //!    parallel; hours are independent, so the numbers do not depend on the
 //!    thread count; occupied hours are counted as they come. The table
-//!    holds sensors × sun-up hours (5.4 MB for the office's 150 sensors);
-//!    past [`MAX_TABLE_BYTES`] none is made and the sun is traced hour by
-//!    hour, so memory stays bounded by the sensors and threads (unless
-//!    every hour is kept for `--hourly`).
+//!    (sensors × sun-up hours: 5.4 MB for the office's 150 sensors) is
+//!    written as it is traced and read back an hour at a time, never held
+//!    whole; with no cache folder, or past [`MAX_TABLE_BYTES`] on disk,
+//!    the sun is traced hour by hour instead. Memory follows sensors × sky
+//!    bins and threads, not the hours (unless every hour is kept for
+//!    `--hourly`).
 //! 4. ASE counts the direct sun alone (no sky, no interreflection).
 //!
 //! 5. LM-83 operable shades (`[[shades]]`): in each occupied hour a group
@@ -267,7 +269,8 @@ pub struct AnnualOptions<'a> {
     /// (a sweep of panel keys keeps one set for every combination).
     pub coefficients: Option<&'a SensorCoefficients>,
     /// The year's sun on the model at the site, when the caller has it
-    /// ([`SunHours::cached`]); made by the run otherwise. With shades
+    /// ([`SunHours::cached`]); made by the run otherwise (through
+    /// `sun_cache`). With shades
     /// studied it must keep the shade groups' sun.
     pub sun_hours: Option<&'a SunHours>,
     /// Where the run keeps the year's sun it makes (the light cache
@@ -280,7 +283,8 @@ pub struct AnnualOptions<'a> {
 /// groups whose windows let too much direct sun onto the point sensors and
 /// reads DA and UDI with them down (ASE always with every shade up).
 /// `progress` hears the share of days done (from any thread). Fails only
-/// when a shaded model cannot be made.
+/// when a shaded model cannot be made or the cached year's sun cannot be
+/// read.
 pub fn annual(
     model: &LightModel,
     site: &Site,
@@ -310,9 +314,10 @@ pub fn annual(
             return Err("the year's sun was traced for another scene, site or shade study".into());
         }
         Some(table) => YearSun::Table(table),
-        None => match SunHours::cached(model, coefficients, site, shades.is_some(), options.sun_cache, &|done| {
-            progress(SUN_TRACING_SHARE * done)
-        })? {
+        None => match options
+            .sun_cache
+            .and_then(|dir| SunHours::cached(model, coefficients, site, shades.is_some(), dir, &|done| progress(SUN_TRACING_SHARE * done)))
+        {
             Some((table, _)) => {
                 own_table = table;
                 YearSun::Table(&own_table)
@@ -332,10 +337,12 @@ pub fn annual(
     // and its sun path around the suns of the hours it reads.
     let down: Vec<u32> = par_map(None, HOURS, |k| match lit(k) {
         Some(sky) if groups > 0 && occupancy.contains(weather.hours[k].hour) => {
-            shades_down(model, year_sun.through_shades(k).as_deref(), sky)
+            Ok(shades_down(model, year_sun.through_shades(k)?.as_deref(), sky))
         }
-        _ => 0,
-    });
+        _ => Ok(0),
+    })
+    .into_iter()
+    .collect::<Result<_, String>>()?;
     let combinations: std::collections::BTreeSet<u32> = down.iter().copied().filter(|&m| m != 0).collect();
     let shaded_models: Vec<(u32, LightModel)> = combinations
         .into_iter()
@@ -360,23 +367,26 @@ pub fn annual(
     // hours (unless every hour is kept). Hours are independent, so the
     // split does not change a number.
     let runs = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let year: Vec<(Tally, Vec<Vec<f32>>)> = par_map(None, runs, |run| {
+    // (total with the hour's shades, direct sun with every shade up) per
+    // sensor; `None` when the hour is dark.
+    let readings = |k: usize| -> Result<Option<Vec<(f64, f64)>>, String> {
+        let Some(sky) = lit(k) else { return Ok(None) };
+        let open = coefficients.readings_with_sun(model, sky, year_sun.response(k)?.as_ref(), Some(1));
+        Ok(Some(match shaded.iter().find(|(mask, ..)| *mask == down[k]) {
+            Some((_, shaded_model, coefficients, path)) => {
+                let lowered = coefficients.readings_on_path(shaded_model, sky, path, Some(1));
+                lowered.iter().zip(&open).map(|(l, o)| (l.total, o.direct_sun)).collect()
+            }
+            None => open.iter().map(|r| (r.total, r.direct_sun)).collect(),
+        }))
+    };
+    let year = par_map(None, runs, |run| -> Result<(Tally, Vec<Vec<f32>>), String> {
         let mut tally = Tally::new(sensor_count);
         let mut hourly = Vec::new();
         for k in run * days / runs * 24..(run + 1) * days / runs * 24 {
             let hour = &weather.hours[k];
             tally.skipped += usize::from(skies[k].is_err());
-            // (total with the hour's shades, direct sun with every shade up) per sensor.
-            let readings: Option<Vec<(f64, f64)>> = lit(k).map(|sky| {
-                let open = coefficients.readings_with_sun(model, sky, year_sun.response(k).as_deref(), Some(1));
-                match shaded.iter().find(|(mask, ..)| *mask == down[k]) {
-                    Some((_, shaded_model, coefficients, path)) => {
-                        let lowered = coefficients.readings_on_path(shaded_model, sky, path, Some(1));
-                        lowered.iter().zip(&open).map(|(l, o)| (l.total, o.direct_sun)).collect()
-                    }
-                    None => open.iter().map(|r| (r.total, r.direct_sun)).collect(),
-                }
-            });
+            let readings = readings(k)?;
             if occupancy.contains(hour.hour) {
                 tally.count(readings.as_deref(), down[k] != 0);
             }
@@ -388,8 +398,10 @@ pub fn annual(
                 progress(tracing_share + (1.0 - tracing_share) * finished as f64 / days as f64);
             }
         }
-        (tally, hourly)
-    });
+        Ok((tally, hourly))
+    })
+    .into_iter()
+    .collect::<Result<Vec<_>, String>>()?;
     let tally = year.iter().fold(Tally::new(sensor_count), |sum, (run, _)| sum.merge(run));
     let occupied_hours = tally.occupied;
     let percent = |n: u32| if occupied_hours == 0 { 0.0 } else { 100.0 * f64::from(n) / occupied_hours as f64 };

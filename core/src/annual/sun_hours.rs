@@ -13,14 +13,13 @@
 //! material's light (reflectances, glass, panel keys), the site, the shade
 //! groups.
 
-use std::borrow::Cow;
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::DVec3;
 
 use super::hour_time;
-use crate::light::cache::{self, CacheOutcome, Fnv, Reader, Writer};
+use crate::light::cache::{self, CacheOutcome, Fnv, StreamedReader, StreamedWriter};
 use crate::light::coefficients::SunResponse;
 use crate::light::{LightModel, SensorCoefficients, SunPath, par_map};
 use crate::scene::MaterialKind;
@@ -32,61 +31,99 @@ use crate::weather::{HOURS, calendar};
 /// Bump when the table or how it is traced changes.
 const FORMAT: u32 = 1;
 
-/// The most a table may hold, bytes. Past it (a grid of tens of thousands
-/// of sensors) the year's sun is traced hour by hour instead
-/// ([`YearSun::Traced`]) and not cached: memory then follows the sensors
-/// and the threads, not the hours.
+/// The most a table may take on disk, bytes. Past it (a grid of tens of
+/// thousands of sensors) the year's sun is traced hour by hour instead
+/// ([`YearSun::Traced`]) and not cached.
 pub const MAX_TABLE_BYTES: usize = 256 << 20;
 
-/// The sun's light at every sensor for each sun-up hour of the year.
-#[derive(Debug, Clone, PartialEq)]
+/// Hours traced together, then written out: memory while tracing follows
+/// sensors × these hours (about five days), not the year.
+const HOURS_PER_BATCH: usize = 64;
+
+/// The sun's light at every sensor for each sun-up hour of the year, kept
+/// in a file of the light cache and read an hour at a time: memory follows
+/// the sensors, not the hours.
+///
+/// The file's payload: sensors, shade groups and rows (`u32` each), each
+/// hour's row (`u32::MAX` with the sun down), then the rows, each the
+/// sensors' direct sun, their interreflected sun and the direct sun through
+/// each shade group's windows (`f32`, lux per W/m² of direct normal
+/// irradiance).
 pub struct SunHours {
     /// What the table was traced for ([`Self::key`]).
     key: u64,
     sensors: usize,
     /// Shade groups whose windows' direct sun is kept (0 when not studied).
     shade_groups: usize,
-    /// Each hour's row in `rows`, `None` when the sun is down.
+    /// Each hour's row in the file, `None` when the sun is down.
     row_of_hour: Vec<Option<u32>>,
-    rows: Vec<SunHour>,
+    file: StreamedReader,
 }
 
-/// One sun-up hour.
-#[derive(Debug, Clone, PartialEq)]
-struct SunHour {
-    response: SunResponse,
-    /// Direct sun through each shade group's windows, lux per W/m²,
-    /// `[group][sensor]`.
-    through_shades: Vec<f32>,
-}
+/// Where the rows start in the payload.
+const ROWS_AT: u64 = 4 * (3 + HOURS as u64);
 
 impl SunHours {
-    /// Traces every sun-up hour of the year at `site` (`shades`: keep each
-    /// shade group's direct sun too), `threads` as [`par_map`]; `progress`
-    /// hears the share of hours done (from any thread).
-    pub fn trace(
+    /// The year's sun of `model` at `site` (`shades`: with each shade
+    /// group's direct sun) from the light cache in `dir`, traced and stored
+    /// there first when it is not; `progress` hears the share of the hours
+    /// traced (from any thread). `None` when the table would take more than
+    /// [`MAX_TABLE_BYTES`] or cannot be stored: the year then traces its
+    /// sun hour by hour ([`YearSun::Traced`], the same numbers).
+    pub fn cached(
         model: &LightModel,
         coefficients: &SensorCoefficients,
         site: &Site,
         shades: bool,
-        threads: Option<usize>,
+        dir: &Path,
         progress: &(dyn Fn(f64) + Sync),
-    ) -> Self {
-        let directions: Vec<Option<DVec3>> = par_map(threads, HOURS, |k| sun_direction(site, k));
-        let up: Vec<DVec3> = directions.iter().flatten().copied().collect();
-        let path = SunPath::new(model, coefficients, site, &up, threads);
+    ) -> Option<(Self, CacheOutcome)> {
+        let suns = sun_directions(site);
         let shade_groups = if shades { model.scene.shades.len() } else { 0 };
-        let done = AtomicUsize::new(0);
-        let rows = par_map(threads, up.len(), |r| {
-            let row = SunHour {
-                response: coefficients.sun_response(model, up[r], &path, Some(1)),
-                through_shades: through_shades(model, up[r], shade_groups),
-            };
-            progress((done.fetch_add(1, Ordering::Relaxed) + 1) as f64 / up.len() as f64);
-            row
-        });
+        let sun_up = suns.iter().flatten().count();
+        if model.scene.sensors.len() * (2 + shade_groups) * sun_up * size_of::<f32>() > MAX_TABLE_BYTES {
+            return None;
+        }
+        let key = Self::key(model, site, shades);
+        let path = cache::file_path(dir, &format!("{key:016x}-sun-hours"));
+        // Every start tidies: temporary files of processes killed mid-write go.
+        cache::tidy(dir, &path, cache::size_limit());
+        let rebuilt = match StreamedReader::open(&path, key) {
+            None => None,
+            Some(Ok(file)) => match Self::open(file, key, model, shades) {
+                Some(table) => {
+                    cache::mark_used(&path);
+                    return Some((table, CacheOutcome::Hit(path)));
+                }
+                None => Some(cache::DOES_NOT_FIT.to_string()),
+            },
+            Some(Err(why)) => Some(why),
+        };
+        let mut out = StreamedWriter::create(&path, key).ok()?;
+        let row_of_hour = Self::trace(model, coefficients, site, &suns, shade_groups, &mut out, progress).ok()?;
+        let file = out.finish().ok()?;
+        cache::tidy(dir, &path, cache::size_limit());
+        let outcome = match rebuilt {
+            Some(why) => CacheOutcome::Rebuilt(path, why),
+            None => CacheOutcome::Stored(path),
+        };
+        Some((Self { key, sensors: model.scene.sensors.len(), shade_groups, row_of_hour, file }, outcome))
+    }
+
+    /// Traces every sun-up hour of `suns` (one per hour of the year) into
+    /// `out`, a batch of hours at a time; each hour's row.
+    fn trace(
+        model: &LightModel,
+        coefficients: &SensorCoefficients,
+        site: &Site,
+        suns: &[Option<DVec3>],
+        shade_groups: usize,
+        out: &mut StreamedWriter,
+        progress: &(dyn Fn(f64) + Sync),
+    ) -> std::io::Result<Vec<Option<u32>>> {
+        let up: Vec<DVec3> = suns.iter().flatten().copied().collect();
         let mut next = 0;
-        let row_of_hour = directions
+        let row_of_hour: Vec<Option<u32>> = suns
             .iter()
             .map(|d| {
                 d.map(|_| {
@@ -95,33 +132,46 @@ impl SunHours {
                 })
             })
             .collect();
-        Self { key: Self::key(model, site, shades), sensors: model.scene.sensors.len(), shade_groups, row_of_hour, rows }
+        let counts = [model.scene.sensors.len(), shade_groups, up.len()].map(|n| n as u32);
+        let rows = row_of_hour.iter().map(|row| row.unwrap_or(u32::MAX));
+        out.append(&counts.into_iter().chain(rows).flat_map(u32::to_le_bytes).collect::<Vec<u8>>())?;
+        let path = SunPath::new(model, coefficients, site, &up, None);
+        let done = AtomicUsize::new(0);
+        for batch in up.chunks(HOURS_PER_BATCH) {
+            let rows = par_map(None, batch.len(), |r| {
+                let response = coefficients.sun_response(model, batch[r], &path, Some(1));
+                let through = through_shades(model, batch[r], shade_groups);
+                progress((done.fetch_add(1, Ordering::Relaxed) + 1) as f64 / up.len() as f64);
+                let values = response.direct.iter().chain(&response.interreflected).chain(&through);
+                values.flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>()
+            });
+            for row in rows {
+                out.append(&row)?;
+            }
+        }
+        Ok(row_of_hour)
     }
 
-    /// [`Self::trace`] through the light cache in `dir` (none: traced each
-    /// time); `None` when the table would hold more than
-    /// [`MAX_TABLE_BYTES`] (the year then traces its sun hour by hour).
-    pub fn cached(
-        model: &LightModel,
-        coefficients: &SensorCoefficients,
-        site: &Site,
-        shades: bool,
-        dir: Option<&Path>,
-        progress: &(dyn Fn(f64) + Sync),
-    ) -> Result<Option<(Self, CacheOutcome)>, String> {
-        if !Self::fits_in_memory(model, site, shades) {
-            return Ok(None);
+    /// The table in `file`; `None` when it does not fit the model.
+    fn open(file: StreamedReader, key: u64, model: &LightModel, shades: bool) -> Option<Self> {
+        let mut head = vec![0u8; ROWS_AT as usize];
+        file.read_at(0, &mut head).ok()?;
+        let words: Vec<u32> = head.chunks_exact(4).map(|b| u32::from_le_bytes(b.try_into().expect("4 bytes"))).collect();
+        let (sensors, shade_groups, row_count) = (words[0] as usize, words[1] as usize, words[2] as usize);
+        let expected_groups = if shades { model.scene.shades.len() } else { 0 };
+        if sensors != model.scene.sensors.len() || shade_groups != expected_groups || row_count > HOURS {
+            return None;
         }
-        let key = Self::key(model, site, shades);
-        cache::through_cache(
-            dir,
-            &format!("{key:016x}-sun-hours"),
-            key,
-            |payload| Self::read(payload, key, model, shades),
-            || Ok(Self::trace(model, coefficients, site, shades, None, progress)),
-            Self::write,
-        )
-        .map(Some)
+        let row_of_hour = words[3..]
+            .iter()
+            .map(|&row| match row {
+                u32::MAX => Some(None),
+                row if (row as usize) < row_count => Some(Some(row)),
+                _ => None,
+            })
+            .collect::<Option<Vec<_>>>()?;
+        let row_bytes = (2 + shade_groups) * sensors * size_of::<f32>();
+        (file.len() == ROWS_AT + (row_count * row_bytes) as u64).then_some(Self { key, sensors, shade_groups, row_of_hour, file })
     }
 
     /// What the table depends on: the scene's precomputation
@@ -157,72 +207,34 @@ impl SunHours {
         self.key == Self::key(model, site, shades) && self.sensors == model.scene.sensors.len()
     }
 
-    /// Hour `k`'s response (hour of the 365-day year), `None` with the sun down.
-    pub fn response(&self, k: usize) -> Option<&SunResponse> {
-        self.row(k).map(|row| &row.response)
+    /// Hour `k`'s response (hour of the 365-day year), `Ok(None)` with the
+    /// sun down; an error when the file cannot be read.
+    pub fn response(&self, k: usize) -> Result<Option<SunResponse>, String> {
+        Ok(self.read_row(k, 0..2 * self.sensors)?.map(|mut direct| {
+            let interreflected = direct.split_off(self.sensors);
+            SunResponse { direct, interreflected }
+        }))
     }
 
     /// Hour `k`'s direct sun through each shade group's windows, lux per
-    /// W/m², `[group][sensor]`; `None` with the sun down.
-    pub fn through_shades(&self, k: usize) -> Option<&[f32]> {
-        self.row(k).map(|row| row.through_shades.as_slice())
+    /// W/m², `[group][sensor]`; `Ok(None)` with the sun down.
+    pub fn through_shades(&self, k: usize) -> Result<Option<Vec<f32>>, String> {
+        self.read_row(k, 2 * self.sensors..(2 + self.shade_groups) * self.sensors)
     }
 
-    /// Whether a table of `model` at `site` stays within [`MAX_TABLE_BYTES`].
-    fn fits_in_memory(model: &LightModel, site: &Site, shades: bool) -> bool {
-        let groups = if shades { model.scene.shades.len() } else { 0 };
-        let sun_up = par_map(None, HOURS, |k| sun_direction(site, k).is_some()).into_iter().filter(|&up| up).count();
-        model.scene.sensors.len() * (2 + groups) * sun_up * size_of::<f32>() <= MAX_TABLE_BYTES
-    }
-
-    fn row(&self, k: usize) -> Option<&SunHour> {
-        self.row_of_hour.get(k).copied().flatten().map(|r| &self.rows[r as usize])
-    }
-
-    fn write(&self) -> Vec<u8> {
-        let mut w = Writer::default();
-        for n in [self.sensors, self.shade_groups, self.rows.len()] {
-            w.u32(n as u32);
-        }
-        for row in &self.row_of_hour {
-            w.u32(row.unwrap_or(u32::MAX));
-        }
-        for row in &self.rows {
-            for value in row.response.direct.iter().chain(&row.response.interreflected).chain(&row.through_shades) {
-                w.f32(*value);
-            }
-        }
-        w.0
-    }
-
-    /// The table from the cache; `None` when it does not fit the model.
-    fn read(payload: &[u8], key: u64, model: &LightModel, shades: bool) -> Option<Self> {
-        let mut r = Reader(payload);
-        let (sensors, shade_groups, row_count) = (r.u32()? as usize, r.u32()? as usize, r.u32()? as usize);
-        let expected_groups = if shades { model.scene.shades.len() } else { 0 };
-        if sensors != model.scene.sensors.len() || shade_groups != expected_groups || row_count > HOURS {
-            return None;
-        }
-        let row_of_hour = (0..HOURS)
-            .map(|_| match r.u32()? {
-                u32::MAX => Some(None),
-                row if (row as usize) < row_count => Some(Some(row)),
-                _ => None,
-            })
-            .collect::<Option<Vec<_>>>()?;
-        let mut floats = |n: usize| (0..n).map(|_| r.f32()).collect::<Option<Vec<f32>>>();
-        let rows = (0..row_count)
-            .map(|_| {
-                let response = SunResponse { direct: floats(sensors)?, interreflected: floats(sensors)? };
-                Some(SunHour { response, through_shades: floats(shade_groups * sensors)? })
-            })
-            .collect::<Option<Vec<_>>>()?;
-        r.is_empty().then_some(Self { key, sensors, shade_groups, row_of_hour, rows })
+    /// The values `range` of hour `k`'s row.
+    fn read_row(&self, k: usize, range: std::ops::Range<usize>) -> Result<Option<Vec<f32>>, String> {
+        let Some(row) = self.row_of_hour.get(k).copied().flatten() else { return Ok(None) };
+        let row_values = (2 + self.shade_groups) * self.sensors;
+        let offset = ROWS_AT + ((row as usize * row_values + range.start) * size_of::<f32>()) as u64;
+        let mut bytes = vec![0u8; range.len() * size_of::<f32>()];
+        self.file.read_at(offset, &mut bytes).map_err(|e| format!("cannot read the year's sun from the light cache: {e}"))?;
+        Ok(Some(bytes.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes"))).collect()))
     }
 }
 
-/// Where a year's hours get their sun: a table, or traced hour by hour where
-/// a table would not fit in memory ([`SunHours::fits_in_memory`]).
+/// Where a year's hours get their sun: the cached table, or traced hour by
+/// hour where none is kept ([`SunHours::cached`]).
 pub(super) enum YearSun<'a> {
     Table(&'a SunHours),
     Traced {
@@ -238,32 +250,37 @@ pub(super) enum YearSun<'a> {
 impl<'a> YearSun<'a> {
     /// Hour by hour: the sun path of the year at `site`.
     pub(super) fn traced(model: &'a LightModel, coefficients: &'a SensorCoefficients, site: &'a Site, shades: bool) -> Self {
-        let up: Vec<DVec3> = par_map(None, HOURS, |k| sun_direction(site, k)).into_iter().flatten().collect();
+        let up: Vec<DVec3> = sun_directions(site).into_iter().flatten().collect();
         let path = SunPath::new(model, coefficients, site, &up, None);
         let shade_groups = if shades { model.scene.shades.len() } else { 0 };
         YearSun::Traced { model, coefficients, site, path, shade_groups }
     }
 
-    /// Hour `k`'s response, `None` with the sun down.
-    pub(super) fn response(&self, k: usize) -> Option<Cow<'_, SunResponse>> {
+    /// Hour `k`'s response, `Ok(None)` with the sun down.
+    pub(super) fn response(&self, k: usize) -> Result<Option<SunResponse>, String> {
         match self {
-            YearSun::Table(table) => table.response(k).map(Cow::Borrowed),
+            YearSun::Table(table) => table.response(k),
             YearSun::Traced { model, coefficients, site, path, .. } => {
-                sun_direction(site, k).map(|sun| Cow::Owned(coefficients.sun_response(model, sun, path, Some(1))))
+                Ok(sun_direction(site, k).map(|sun| coefficients.sun_response(model, sun, path, Some(1))))
             }
         }
     }
 
     /// Hour `k`'s direct sun through each shade group's windows
-    /// ([`SunHours::through_shades`]), `None` with the sun down.
-    pub(super) fn through_shades(&self, k: usize) -> Option<Cow<'_, [f32]>> {
+    /// ([`SunHours::through_shades`]), `Ok(None)` with the sun down.
+    pub(super) fn through_shades(&self, k: usize) -> Result<Option<Vec<f32>>, String> {
         match self {
-            YearSun::Table(table) => table.through_shades(k).map(Cow::Borrowed),
+            YearSun::Table(table) => table.through_shades(k),
             YearSun::Traced { model, site, shade_groups, .. } => {
-                sun_direction(site, k).map(|sun| Cow::Owned(through_shades(model, sun, *shade_groups)))
+                Ok(sun_direction(site, k).map(|sun| through_shades(model, sun, *shade_groups)))
             }
         }
     }
+}
+
+/// The sun's direction at the middle of every hour of the year ([`sun_direction`]).
+fn sun_directions(site: &Site) -> Vec<Option<DVec3>> {
+    par_map(None, HOURS, |k| sun_direction(site, k))
 }
 
 /// The sun's direction in the model's frame at the middle of hour `k` of the
@@ -305,23 +322,30 @@ mod tests {
     use crate::light::LightSettings;
     use crate::panel::PanelCatalog;
 
-    /// Traced hour by hour (a table too big for memory) the year's sun is
-    /// the table's, hour for hour.
+    /// Traced hour by hour (where no table is kept) the year's sun is the
+    /// cached table's, hour for hour; the table written and the same table
+    /// read back are one.
     #[test]
     fn hours_traced_one_by_one_are_the_tables() {
         let scene = crate::scene::load_scene(&crate::bundled_scene("test_room"), &PanelCatalog::new()).unwrap().scene;
         let site = scene.site;
         let model = LightModel::precompute(Arc::new(scene), LightSettings::default()).unwrap();
         let coefficients = model.sensor_coefficients();
-        let table = SunHours::trace(&model, &coefficients, &site, false, None, &|_| {});
-        assert!(SunHours::fits_in_memory(&model, &site, false));
+        let dir = std::env::temp_dir().join(format!("heliodon-sun-hours-unit-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let (written, outcome) = SunHours::cached(&model, &coefficients, &site, false, &dir, &|_| {}).expect("a small table is kept");
+        assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");
+        let (read, outcome) = SunHours::cached(&model, &coefficients, &site, false, &dir, &|_| {}).expect("a small table is kept");
+        assert!(matches!(outcome, CacheOutcome::Hit(_)), "{outcome:?}");
         let traced = YearSun::traced(&model, &coefficients, &site, false);
         let mut lit = 0;
         for k in (0..HOURS).step_by(97) {
-            let (from_table, one_by_one) = (table.response(k), traced.response(k));
-            assert_eq!(from_table, one_by_one.as_deref(), "hour {k}");
+            let from_table = written.response(k).unwrap();
+            assert_eq!(from_table, read.response(k).unwrap(), "hour {k}");
+            assert_eq!(from_table, traced.response(k).unwrap(), "hour {k}");
             lit += usize::from(from_table.is_some_and(|r| r.direct.iter().any(|&e| e > 0.0)));
         }
         assert!(lit > 10, "{lit} sunny hours compared");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -9,8 +9,9 @@
 //! temporary files of processes that died mid-write are removed.
 
 use std::fs;
+use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, SystemTime};
 
 use glam::DVec3;
@@ -140,6 +141,11 @@ pub fn precompute_cached(
     )
 }
 
+/// Where the cache file `name` lives in `dir`.
+pub fn file_path(dir: &Path, name: &str) -> PathBuf {
+    dir.join(format!("light-{name}.bin"))
+}
+
 /// One file of the cache (`light-{name}.bin` in `dir`) stored under `key`:
 /// loaded when it is whole and `load` accepts it, else made by `compute`
 /// and stored as `save` writes it (none: no cache, computed each time).
@@ -154,20 +160,19 @@ pub fn through_cache<T>(
     let Some(dir) = dir else {
         return Ok((compute()?, CacheOutcome::Skipped("disabled".into())));
     };
-    let path = dir.join(format!("light-{name}.bin"));
+    let path = file_path(dir, name);
     // Every start tidies: temporary files of processes killed mid-write go,
     // and the folder keeps to its bound.
     tidy(dir, &path, size_limit());
     let mut rebuilt = None;
     if let Ok(bytes) = fs::read(&path) {
         match decode(&bytes, key) {
-            Ok(payload) => match load(&payload) {
+            Ok(payload) => match load(payload) {
                 Some(value) => {
-                    // Used now: the last to be evicted.
-                    let _ = fs::File::options().append(true).open(&path).and_then(|f| f.set_modified(SystemTime::now()));
+                    mark_used(&path);
                     return Ok((value, CacheOutcome::Hit(path)));
                 }
-                None => rebuilt = Some("its contents do not fit the scene".to_string()),
+                None => rebuilt = Some(DOES_NOT_FIT.to_string()),
             },
             Err(why) => rebuilt = Some(why),
         }
@@ -175,7 +180,7 @@ pub fn through_cache<T>(
     let value = compute()?;
     let stored = fs::create_dir_all(dir).and_then(|_| {
         // Write then rename, so a reader never sees half a file.
-        let partial = path.with_extension(format!("tmp{}", std::process::id()));
+        let partial = temporary_path(&path);
         fs::write(&partial, encode(&save(&value), key))?;
         fs::rename(&partial, &path)
     });
@@ -188,6 +193,126 @@ pub fn through_cache<T>(
         (Ok(()), None) => CacheOutcome::Stored(path),
     };
     Ok((value, outcome))
+}
+
+/// Why a whole file was not used: what it holds is for another scene.
+pub(crate) const DOES_NOT_FIT: &str = "its contents do not fit the scene";
+
+/// Used now: the last file to be evicted.
+pub(crate) fn mark_used(path: &Path) {
+    let _ = fs::File::options().append(true).open(path).and_then(|f| f.set_modified(SystemTime::now()));
+}
+
+/// Where a file is written before it is renamed into place.
+fn temporary_path(path: &Path) -> PathBuf {
+    path.with_extension(format!("tmp{}", std::process::id()))
+}
+
+/// A cache file too big to hold in memory, written as its payload comes:
+/// into a temporary file, checksummed on the way, then renamed into place
+/// whole ([`Self::finish`]). Dropped unfinished, the temporary file goes.
+pub(crate) struct StreamedWriter {
+    out: io::BufWriter<fs::File>,
+    partial: PathBuf,
+    path: PathBuf,
+    key: u64,
+    len: u64,
+    checksum: Fnv,
+}
+
+impl StreamedWriter {
+    /// Starts `path`'s file (its folder made if need be).
+    pub fn create(path: &Path, key: u64) -> io::Result<Self> {
+        if let Some(dir) = path.parent() {
+            fs::create_dir_all(dir)?;
+        }
+        let partial = temporary_path(path);
+        let file = fs::File::options().read(true).write(true).create(true).truncate(true).open(&partial)?;
+        let mut out = io::BufWriter::new(file);
+        out.write_all(&[0; HEADER])?;
+        Ok(Self { out, partial, path: path.to_path_buf(), key, len: 0, checksum: Fnv::new() })
+    }
+
+    /// Appends to the payload.
+    pub fn append(&mut self, bytes: &[u8]) -> io::Result<()> {
+        self.checksum.bytes(bytes);
+        self.len += bytes.len() as u64;
+        self.out.write_all(bytes)
+    }
+
+    /// Writes the header, puts the file in place and keeps it open for
+    /// reading (what was written needs no second check).
+    pub fn finish(mut self) -> io::Result<StreamedReader> {
+        self.out.flush()?;
+        let file = self.out.get_mut();
+        file.seek(SeekFrom::Start(0))?;
+        file.write_all(&header(self.key, self.len, self.checksum.0))?;
+        fs::rename(&self.partial, &self.path)?;
+        let file = self.out.get_ref().try_clone()?;
+        Ok(StreamedReader { file: Mutex::new(file), len: self.len })
+    }
+}
+
+impl Drop for StreamedWriter {
+    fn drop(&mut self) {
+        // Gone already when renamed into place.
+        let _ = fs::remove_file(&self.partial);
+    }
+}
+
+/// A cache file read piece by piece in place ([`Self::read_at`]), its
+/// header and whole-payload checksum checked once when opened; the open
+/// file stays the one checked even if another process replaces or evicts
+/// the path meanwhile.
+pub(crate) struct StreamedReader {
+    file: Mutex<fs::File>,
+    len: u64,
+}
+
+impl StreamedReader {
+    /// `path`'s file when it is whole and stored under `key`; `None` when
+    /// there is no file, `Some(Err(why))` when it cannot be trusted.
+    pub fn open(path: &Path, key: u64) -> Option<Result<Self, String>> {
+        let mut file = fs::File::open(path).ok()?;
+        Some((|| {
+            let mut head = Vec::with_capacity(HEADER);
+            Read::by_ref(&mut file).take(HEADER as u64).read_to_end(&mut head).map_err(|e| format!("cannot read: {e}"))?;
+            let (len, checksum) = read_header(&head, key)?;
+            let mut hash = Fnv::new();
+            let mut chunk = vec![0; 1 << 20];
+            let mut read = 0u64;
+            loop {
+                let n = file.read(&mut chunk).map_err(|e| format!("cannot read: {e}"))?;
+                if n == 0 {
+                    break;
+                }
+                hash.bytes(&chunk[..n]);
+                read += n as u64;
+            }
+            if read != len {
+                return Err("truncated".into());
+            }
+            if hash.0 != checksum {
+                return Err("checksum mismatch".into());
+            }
+            Ok(Self { file: Mutex::new(file), len })
+        })())
+    }
+
+    /// The payload's length in bytes.
+    pub fn len(&self) -> u64 {
+        self.len
+    }
+
+    /// Fills `buf` from the payload at `offset`.
+    pub fn read_at(&self, offset: u64, buf: &mut [u8]) -> io::Result<()> {
+        if offset + buf.len() as u64 > self.len {
+            return Err(io::Error::new(io::ErrorKind::UnexpectedEof, "past the end of the payload"));
+        }
+        let mut file = self.file.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        file.seek(SeekFrom::Start(HEADER as u64 + offset))?;
+        file.read_exact(buf)
+    }
 }
 
 /// The cache folder's bound in bytes: `$HELIODON_CACHE_MAX_MB` (MiB), else
@@ -235,19 +360,24 @@ pub fn tidy(dir: &Path, keep: &Path, limit: u64) {
     }
 }
 
-fn encode(payload: &[u8], key: u64) -> Vec<u8> {
-    let mut out = Vec::with_capacity(payload.len() + 36);
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&FORMAT.to_le_bytes());
-    out.extend_from_slice(&key.to_le_bytes());
-    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    out.extend_from_slice(&Fnv::new().bytes(payload).0.to_le_bytes());
-    out.extend_from_slice(payload);
+/// The bytes before a file's payload: magic, format, key, the payload's
+/// length and its checksum.
+const HEADER: usize = 36;
+
+fn header(key: u64, len: u64, checksum: u64) -> [u8; HEADER] {
+    let mut out = [0; HEADER];
+    out[..8].copy_from_slice(MAGIC);
+    out[8..12].copy_from_slice(&FORMAT.to_le_bytes());
+    out[12..20].copy_from_slice(&key.to_le_bytes());
+    out[20..28].copy_from_slice(&len.to_le_bytes());
+    out[28..].copy_from_slice(&checksum.to_le_bytes());
     out
 }
 
-fn decode(bytes: &[u8], key: u64) -> Result<Vec<u8>, String> {
-    if bytes.len() < 36 || &bytes[..8] != MAGIC {
+/// The payload's length and checksum a header gives, when it is a light
+/// cache of this format stored under `key`.
+fn read_header(bytes: &[u8], key: u64) -> Result<(u64, u64), String> {
+    if bytes.len() < HEADER || &bytes[..8] != MAGIC {
         return Err("not a heliodon light cache".into());
     }
     let u32_at = |i: usize| u32::from_le_bytes(bytes[i..i + 4].try_into().expect("4 bytes"));
@@ -258,14 +388,26 @@ fn decode(bytes: &[u8], key: u64) -> Result<Vec<u8>, String> {
     if u64_at(12) != key {
         return Err("key mismatch".into());
     }
-    let payload = &bytes[36..];
-    if u64_at(20) != payload.len() as u64 {
+    Ok((u64_at(20), u64_at(28)))
+}
+
+fn encode(payload: &[u8], key: u64) -> Vec<u8> {
+    let mut out = Vec::with_capacity(payload.len() + HEADER);
+    out.extend_from_slice(&header(key, payload.len() as u64, Fnv::new().bytes(payload).0));
+    out.extend_from_slice(payload);
+    out
+}
+
+fn decode(bytes: &[u8], key: u64) -> Result<&[u8], String> {
+    let (len, checksum) = read_header(bytes, key)?;
+    let payload = &bytes[HEADER..];
+    if len != payload.len() as u64 {
         return Err("truncated".into());
     }
-    if u64_at(28) != Fnv::new().bytes(payload).0 {
+    if checksum != Fnv::new().bytes(payload).0 {
         return Err("checksum mismatch".into());
     }
-    Ok(payload.to_vec())
+    Ok(payload)
 }
 
 /// Little-endian writer of the payload.
