@@ -53,7 +53,10 @@ fn view_screenshot_shows_the_panels_and_the_lit_model() {
     // headless renderer draws the same view at the same size to the same
     // values.
     let (width, height, viewed) = read_hdr(&hdr);
-    assert!(width > 400 && width < 1280 && height == 800, "{width} × {height}: the 3D view between the panels");
+    assert!(
+        width > 400 && width < 1280 && (760..800).contains(&height),
+        "{width} × {height}: the 3D view between the panels, under the menu bar"
+    );
     let rendered = dir.join("test_room_render.hdr");
     let out = Command::new(env!("CARGO_BIN_EXE_heliodon"))
         .arg("render")

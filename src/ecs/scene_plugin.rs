@@ -84,8 +84,10 @@ pub struct SceneLoadFailed {
 /// The scene being shown, and the one being loaded.
 #[derive(Resource, Default)]
 pub struct ActiveScene {
-    /// The loaded scene, once there is one.
+    /// The scene shown, edits included, once there is one.
     pub scene: Option<Arc<Scene>>,
+    /// The same scene as its file gives it (what the edits are made on).
+    pub loaded: Option<Arc<Scene>>,
     pub root: Option<Entity>,
     /// The file it was opened from.
     pub path: Option<PathBuf>,
@@ -171,6 +173,7 @@ fn spawn_loaded_scene(
     let root = spawn_scene(&mut commands, &scene);
     commands.insert_resource(Site(scene.site));
     active.path = active.pending.take().map(|(path, _)| path);
+    active.loaded = Some(scene.clone());
     active.scene = Some(scene);
     active.root = Some(root);
     spawned.write(SceneSpawned { root, edited: false });

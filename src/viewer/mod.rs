@@ -11,18 +11,20 @@
 //! - panel lobes ([`lobes`]), saving the view ([`capture`]),
 //! - drawing only when something changes ([`redraw`]),
 //! - the batch flow of `view --screenshot/--hdr/--sensor` ([`batch`]),
-//! - scene and weather files dropped on the window (here).
+//! - opening and saving files: the File menu, drops, recent scenes ([`files`]),
 //!
 //! The modules form a one-way graph: `schedule` (the system sets),
 //! `focus`, `widgets` and `background` are leaves;
-//! `camera`, `capture`, `sensors`, `annual`, `sweep` and `lobes` read them; `ui`,
-//! `batch` and `redraw` read everything and nothing imports them.
+//! `camera`, `capture`, `sensors`, `annual`, `sweep` and `lobes` read them;
+//! `files` reads `camera` and `annual`; `ui`, `batch` and `redraw` read
+//! everything and nothing imports them.
 
 pub mod annual;
 pub mod background;
 pub mod batch;
 pub mod camera;
 pub mod capture;
+pub mod files;
 pub mod focus;
 pub mod lobes;
 pub mod redraw;
@@ -37,7 +39,7 @@ use std::process::ExitCode;
 
 use bevy::camera::visibility::RenderLayers;
 use bevy::prelude::*;
-use bevy::window::{FileDragAndDrop, PrimaryWindow};
+use bevy::window::PrimaryWindow;
 
 pub use batch::ViewStart;
 pub use schedule::ViewerSystems;
@@ -84,7 +86,6 @@ impl Plugin for ViewerPlugin {
             Update,
             (frame_new_scene.before(ViewerSystems::Camera), title_names_the_scene, failed_load).after(HeliodonSystems::SpawnScene),
         )
-        .add_systems(Update, open_dropped_files.before(HeliodonSystems::SpawnScene))
         .init_resource::<focus::PanelFocus>()
         .init_resource::<widgets::Note>()
         .add_plugins((
@@ -96,6 +97,7 @@ impl Plugin for ViewerPlugin {
             sweep::SweepPlugin,
             lobes::LobesPlugin,
             batch::BatchPlugin,
+            files::FilesPlugin,
             redraw::RedrawPlugin,
         ));
     }
@@ -178,85 +180,5 @@ fn failed_load(
     } else {
         eprintln!("error: {}", failure.message);
         exit.write(AppExit::error());
-    }
-}
-
-/// A file dropped on the window: a scene (`.toml`) opens in place of the
-/// one shown, a weather file (`.epw`) opens for the annual study and the
-/// sky; anything else is named in the note.
-fn open_dropped_files(
-    mut drops: MessageReader<FileDragAndDrop>,
-    mut open: MessageWriter<OpenScene>,
-    mut study: ResMut<annual::AnnualStudy>,
-    mut note: ResMut<widgets::Note>,
-) {
-    for drop in drops.read() {
-        let FileDragAndDrop::DroppedFile { path_buf: path, .. } = drop else { continue };
-        let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-        note.0 = Some(match extension.as_deref() {
-            Some("toml") => {
-                open.write(OpenScene(path.clone()));
-                format!("opening {}", path.display())
-            }
-            Some("epw") => match study.open(path) {
-                Ok(()) => format!("weather: {}", path.display()),
-                Err(e) => e,
-            },
-            _ => format!("{}: heliodon opens scene files (.toml) and weather files (.epw)", path.display()),
-        });
-    }
-}
-
-#[cfg(test)]
-#[path = "../../tests/support/epw.rs"]
-mod epw;
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Drops `file` on a window and runs the drop handler once.
-    fn drop_file(file: &std::path::Path) -> App {
-        let mut app = App::new();
-        app.add_message::<FileDragAndDrop>()
-            .add_message::<OpenScene>()
-            .init_resource::<annual::AnnualStudy>()
-            .init_resource::<widgets::Note>()
-            .add_systems(Update, open_dropped_files);
-        let window = app.world_mut().spawn_empty().id();
-        app.world_mut().write_message(FileDragAndDrop::DroppedFile { window, path_buf: file.to_path_buf() });
-        app.update();
-        app
-    }
-
-    fn note(app: &App) -> String {
-        app.world().resource::<widgets::Note>().0.clone().unwrap_or_default()
-    }
-
-    #[test]
-    fn a_dropped_scene_opens_a_dropped_weather_file_drives_the_sky() {
-        let scene = std::path::Path::new("assets/scenes/test_room/scene.toml");
-        let mut app = drop_file(scene);
-        let opened: Vec<PathBuf> = app.world_mut().resource_mut::<Messages<OpenScene>>().drain().map(|o| o.0).collect();
-        assert_eq!(opened, vec![scene.to_path_buf()]);
-
-        let dir = std::env::temp_dir().join(format!("heliodon-drop-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let epw = dir.join("boston.EPW");
-        std::fs::write(&epw, epw::boston_epw(8760)).unwrap();
-        let app = drop_file(&epw);
-        let study = app.world().resource::<annual::AnnualStudy>();
-        assert!(study.weather.as_ref().is_some_and(|(path, _)| *path == epw) && study.weather_sky, "{}", note(&app));
-
-        // A truncated weather file is refused with its line, in the note.
-        std::fs::write(&epw, epw::boston_epw(100)).unwrap();
-        let app = drop_file(&epw);
-        assert!(app.world().resource::<annual::AnnualStudy>().weather.is_none());
-        assert!(note(&app).contains("boston.EPW"), "{}", note(&app));
-
-        let app = drop_file(&dir.join("picture.png"));
-        assert!(note(&app).contains("opens scene files (.toml) and weather files (.epw)"), "{}", note(&app));
-        assert!(app.world().resource::<Messages<OpenScene>>().is_empty());
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -105,6 +105,16 @@ impl ModelFrame {
         (self.rotation * d).normalize_or_zero()
     }
 
+    /// A canonical point in model space: what [`Self::point`] undoes.
+    pub fn model_point(&self, p: Vec3) -> [f64; 3] {
+        ((self.rotation.transpose() * p).as_dvec3() / f64::from(self.scale) + self.origin).to_array()
+    }
+
+    /// A canonical direction in model space (unit length).
+    pub fn model_direction(&self, d: Vec3) -> Vec3 {
+        (self.rotation.transpose() * d).normalize_or_zero()
+    }
+
     /// A model-space length in metres.
     pub fn length(&self, l: f32) -> f32 {
         l * self.scale

@@ -5,6 +5,7 @@
 //!
 //! Everything is in one canonical frame: metres, x east, y north, z up (as in
 //! Radiance). [`ModelFrame`] maps the model's own axes, north and units into it.
+//! [`save`] writes a scene's edits back into its file.
 
 mod error;
 mod file;
@@ -14,6 +15,7 @@ mod obj;
 mod patches;
 mod polygon;
 mod repair;
+pub mod save;
 pub(crate) use patches::clip as clip_convex;
 mod sensors;
 mod shades;

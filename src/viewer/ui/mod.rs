@@ -2,7 +2,7 @@
 //! panel. Left: the sun and sky ([`sun_and_sky`]: date, time, play, site
 //! and north with a sun-path diagram, sky type and parameters, exposure),
 //! then the windows and materials ([`materials`]) and the sweep of a window
-//! material's keys ([`sweep`]). Right: the camera
+//! material's keys ([`sweep`]). Top: the File menu ([`file`]). Right: the camera
 //! ([`camera`]: presets, viewpoints, walk mode), the view ([`view`]: modes,
 //! the light's progress, saving the image) and the sensors ([`sensors`]:
 //! live table, the selected one's day and year, CSV export) and the annual
@@ -16,6 +16,7 @@
 
 pub mod annual;
 pub mod camera;
+pub mod file;
 pub mod materials;
 pub mod sensors;
 pub mod sun_and_sky;
@@ -36,6 +37,7 @@ use super::widgets::Note;
 use crate::render::{PictureCamera, RenderSettings};
 use crate::viewer::schedule::ViewerSystems;
 use annual::AnnualPanel;
+use file::{FileMenu, FilePrompt};
 use materials::{MaterialEdits, MaterialPanel};
 use sensors::SensorPanel;
 use sun_and_sky::{PlayDay, SunAndSkyPanel};
@@ -49,6 +51,7 @@ impl Plugin for DesignerUiPlugin {
         app.add_plugins(EguiPlugin::default())
             .init_resource::<PlayDay>()
             .init_resource::<MaterialEdits>()
+            .init_resource::<FilePrompt>()
             .add_systems(Startup, spawn_ui_camera)
             .add_systems(EguiPrimaryContextPass, panels.in_set(ViewerSystems::Panels))
             .add_systems(Update, sun_and_sky::play_the_day);
@@ -86,11 +89,13 @@ fn panels(
     mut sensors: SensorPanel,
     mut annual: AnnualPanel,
     mut sweep: SweepPanel,
+    mut file_menu: FileMenu,
     window: Single<&Window, With<PrimaryWindow>>,
     mut cameras: Query<&mut Camera, PictureCamera>,
 ) -> Result {
     let ctx = contexts.ctx_mut()?.clone();
     let mut root = Ui::new(ctx.clone(), "viewport".into(), UiBuilder::new().layer_id(LayerId::background()).max_rect(ctx.viewport_rect()));
+    let top = egui::Panel::top("menu").show(&mut root, |ui| file_menu.show(ui)).response.rect.height();
     let left = egui::Panel::left("sun_and_sky")
         .default_size(270.0)
         .show(&mut root, |ui| {
@@ -129,10 +134,10 @@ fn panels(
     focus.keyboard = ctx.egui_wants_keyboard_input();
     // The 3D view: what the panels leave.
     let scale = window.scale_factor();
-    let (left, right) = ((left * scale) as u32, (right * scale) as u32);
+    let (left, right, top) = ((left * scale) as u32, (right * scale) as u32, (top * scale) as u32);
     let width = window.physical_width().saturating_sub(left + right).max(1);
-    let viewport =
-        Viewport { physical_position: UVec2::new(left, 0), physical_size: UVec2::new(width, window.physical_height().max(1)), ..default() };
+    let height = window.physical_height().saturating_sub(top).max(1);
+    let viewport = Viewport { physical_position: UVec2::new(left, top), physical_size: UVec2::new(width, height), ..default() };
     for mut camera in &mut cameras {
         let same = camera
             .viewport
