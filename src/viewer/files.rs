@@ -106,13 +106,10 @@ fn carry_out_requests(
         note.0 = Some(match request {
             FileRequest::Open(path) => open_file(path, &mut open, &mut study),
             FileRequest::Save | FileRequest::SaveAs(_) => {
-                let to = match request {
-                    FileRequest::SaveAs(to) => Some(to.clone()),
-                    _ => active.path.clone(),
-                };
+                let to = if let FileRequest::SaveAs(to) = request { Some(to.as_path()) } else { None };
                 let north_turn = site.as_ref().map_or(0.0, |s| s.north_turn);
                 let new_viewpoints = cameras.as_ref().map(|c| c.saved_views.clone()).unwrap_or_default();
-                match to.ok_or_else(|| "no scene is open".to_string()).and_then(|to| save(&active, &to, north_turn, &new_viewpoints)) {
+                match save(&active, to, north_turn, &new_viewpoints) {
                     Ok((to, left_out)) => {
                         // The file now holds north and the viewpoints: read
                         // again, the session starts from it.
@@ -146,17 +143,19 @@ fn open_file(path: &Path, open: &mut MessageWriter<OpenScene>, study: &mut Annua
     }
 }
 
-/// Writes the active scene with the session's edits to `to` (whole, then
-/// renamed into place); where it went and the edits left out.
+/// Writes the active scene with the session's edits to `to` (none: over
+/// its own file), whole, then renamed into place; where it went and the
+/// edits left out.
 fn save(
     active: &ActiveScene,
-    to: &Path,
+    to: Option<&Path>,
     north_turn: f64,
     new_viewpoints: &[crate::scene::Viewpoint],
 ) -> Result<(PathBuf, Vec<String>), String> {
     let (Some(from), Some(loaded), Some(edited)) = (&active.path, &active.loaded, &active.scene) else {
         return Err("no scene is open".into());
     };
+    let to = to.unwrap_or(from);
     let to = if to.extension().is_none() { to.with_extension("toml") } else { to.to_path_buf() };
     let text = std::fs::read_to_string(from).map_err(|e| format!("{}: cannot read: {e}", from.display()))?;
     let edits = SceneEdits { loaded, edited, north_turn, new_viewpoints };

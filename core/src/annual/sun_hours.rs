@@ -85,33 +85,17 @@ impl SunHours {
             return None;
         }
         let key = Self::key(model, site, shades);
-        let path = cache::file_path(dir, &format!("{key:016x}-sun-hours"));
-        // Every start tidies: temporary files of processes killed mid-write go.
-        cache::tidy(dir, &path, cache::size_limit());
-        let rebuilt = match StreamedReader::open(&path, key) {
-            None => None,
-            Some(Ok(file)) => match Self::open(file, key, model, shades) {
-                Some(table) => {
-                    cache::mark_used(&path);
-                    return Some((table, CacheOutcome::Hit(path)));
-                }
-                None => Some(cache::DOES_NOT_FIT.to_string()),
-            },
-            Some(Err(why)) => Some(why),
-        };
-        let mut out = StreamedWriter::create(&path, key).ok()?;
-        let row_of_hour = Self::trace(model, coefficients, site, &suns, shade_groups, &mut out, progress).ok()?;
-        let file = out.finish().ok()?;
-        cache::tidy(dir, &path, cache::size_limit());
-        let outcome = match rebuilt {
-            Some(why) => CacheOutcome::Rebuilt(path, why),
-            None => CacheOutcome::Stored(path),
-        };
-        Some((Self { key, sensors: model.scene.sensors.len(), shade_groups, row_of_hour, file }, outcome))
+        cache::through_streamed_cache(
+            dir,
+            &format!("{key:016x}-sun-hours"),
+            key,
+            |file| Self::open(file, key, model, shades),
+            |out| Self::trace(model, coefficients, site, &suns, shade_groups, out, progress),
+        )
     }
 
     /// Traces every sun-up hour of `suns` (one per hour of the year) into
-    /// `out`, a batch of hours at a time; each hour's row.
+    /// `out`, a batch of hours at a time.
     fn trace(
         model: &LightModel,
         coefficients: &SensorCoefficients,
@@ -120,21 +104,18 @@ impl SunHours {
         shade_groups: usize,
         out: &mut StreamedWriter,
         progress: &(dyn Fn(f64) + Sync),
-    ) -> std::io::Result<Vec<Option<u32>>> {
+    ) -> std::io::Result<()> {
         let up: Vec<DVec3> = suns.iter().flatten().copied().collect();
         let mut next = 0;
-        let row_of_hour: Vec<Option<u32>> = suns
-            .iter()
-            .map(|d| {
-                d.map(|_| {
-                    next += 1;
-                    next - 1
-                })
-            })
-            .collect();
+        let row_of_hour = suns.iter().map(|d| match d {
+            Some(_) => {
+                next += 1;
+                next - 1
+            }
+            None => u32::MAX,
+        });
         let counts = [model.scene.sensors.len(), shade_groups, up.len()].map(|n| n as u32);
-        let rows = row_of_hour.iter().map(|row| row.unwrap_or(u32::MAX));
-        out.append(&counts.into_iter().chain(rows).flat_map(u32::to_le_bytes).collect::<Vec<u8>>())?;
+        out.append(&counts.into_iter().chain(row_of_hour).flat_map(u32::to_le_bytes).collect::<Vec<u8>>())?;
         let path = SunPath::new(model, coefficients, site, &up, None);
         let done = AtomicUsize::new(0);
         for batch in up.chunks(HOURS_PER_BATCH) {
@@ -149,7 +130,7 @@ impl SunHours {
                 out.append(&row)?;
             }
         }
-        Ok(row_of_hour)
+        Ok(())
     }
 
     /// The table in `file`; `None` when it does not fit the model.

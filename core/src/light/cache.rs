@@ -142,7 +142,7 @@ pub fn precompute_cached(
 }
 
 /// Where the cache file `name` lives in `dir`.
-pub fn file_path(dir: &Path, name: &str) -> PathBuf {
+fn file_path(dir: &Path, name: &str) -> PathBuf {
     dir.join(format!("light-{name}.bin"))
 }
 
@@ -195,11 +195,47 @@ pub fn through_cache<T>(
     Ok((value, outcome))
 }
 
+/// [`through_cache`] for a file too big to hold in memory: loaded in place
+/// ([`StreamedReader`]) when it is whole and `load` accepts it, else
+/// written by `write` as it is made ([`StreamedWriter`]) and loaded from
+/// what was written. `None` when it can be neither loaded nor stored (the
+/// caller then does without the file).
+pub(crate) fn through_streamed_cache<T>(
+    dir: &Path,
+    name: &str,
+    key: u64,
+    load: impl Fn(StreamedReader) -> Option<T>,
+    write: impl FnOnce(&mut StreamedWriter) -> io::Result<()>,
+) -> Option<(T, CacheOutcome)> {
+    let path = file_path(dir, name);
+    tidy(dir, &path, size_limit());
+    let rebuilt = match StreamedReader::open(&path, key) {
+        None => None,
+        Some(Ok(file)) => match load(file) {
+            Some(value) => {
+                mark_used(&path);
+                return Some((value, CacheOutcome::Hit(path)));
+            }
+            None => Some(DOES_NOT_FIT.to_string()),
+        },
+        Some(Err(why)) => Some(why),
+    };
+    let mut out = StreamedWriter::create(&path, key).ok()?;
+    write(&mut out).ok()?;
+    let value = load(out.finish().ok()?)?;
+    tidy(dir, &path, size_limit());
+    let outcome = match rebuilt {
+        Some(why) => CacheOutcome::Rebuilt(path, why),
+        None => CacheOutcome::Stored(path),
+    };
+    Some((value, outcome))
+}
+
 /// Why a whole file was not used: what it holds is for another scene.
-pub(crate) const DOES_NOT_FIT: &str = "its contents do not fit the scene";
+const DOES_NOT_FIT: &str = "its contents do not fit the scene";
 
 /// Used now: the last file to be evicted.
-pub(crate) fn mark_used(path: &Path) {
+fn mark_used(path: &Path) {
     let _ = fs::File::options().append(true).open(path).and_then(|f| f.set_modified(SystemTime::now()));
 }
 
@@ -289,12 +325,7 @@ impl StreamedReader {
                 hash.bytes(&chunk[..n]);
                 read += n as u64;
             }
-            if read != len {
-                return Err("truncated".into());
-            }
-            if hash.0 != checksum {
-                return Err("checksum mismatch".into());
-            }
+            check_payload((len, checksum), read, hash.0)?;
             Ok(Self { file: Mutex::new(file), len })
         })())
     }
@@ -399,15 +430,22 @@ fn encode(payload: &[u8], key: u64) -> Vec<u8> {
 }
 
 fn decode(bytes: &[u8], key: u64) -> Result<&[u8], String> {
-    let (len, checksum) = read_header(bytes, key)?;
+    let header = read_header(bytes, key)?;
     let payload = &bytes[HEADER..];
-    if len != payload.len() as u64 {
+    check_payload(header, payload.len() as u64, Fnv::new().bytes(payload).0)?;
+    Ok(payload)
+}
+
+/// Whether the payload read (its length and checksum) is the one the
+/// header gives.
+fn check_payload((len, checksum): (u64, u64), read_len: u64, read_checksum: u64) -> Result<(), String> {
+    if read_len != len {
         return Err("truncated".into());
     }
-    if checksum != Fnv::new().bytes(payload).0 {
+    if read_checksum != checksum {
         return Err("checksum mismatch".into());
     }
-    Ok(payload)
+    Ok(())
 }
 
 /// Little-endian writer of the payload.

@@ -155,13 +155,12 @@ fn toml_value(parameter: &toml::Value) -> Value {
 /// The model-space north after the designer's turn of `degrees`.
 fn turned_north(frame: &ModelFrame, degrees: f64) -> Vec3 {
     let (sin, cos) = degrees.to_radians().sin_cos();
-    let north = frame.model_direction(Vec3::new(sin as f32, cos as f32, 0.0));
-    north.map(|c| if c.abs() < 1e-6 { 0.0 } else { (f64::from(c) * 1e6).round() as f32 / 1e6 })
+    frame.model_direction(Vec3::new(sin as f32, cos as f32, 0.0))
 }
 
-/// Numbers as written by hand: six decimals at most.
+/// Numbers as written by hand: six decimals at most, no `-0.0`.
 fn round(v: f64) -> f64 {
-    (v * 1e6).round() / 1e6
+    (v * 1e6).round() / 1e6 + 0.0
 }
 
 fn numbers<const N: usize>(values: [f64; N]) -> Array {
