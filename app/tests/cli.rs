@@ -390,6 +390,36 @@ fn export_radiance_writes_the_same_model_and_sky() {
     assert!((z - 0.01).abs() < 1e-6, "{z}");
 }
 
+/// A panel fitted to a BSDF file is exported as Radiance's `BSDF` material
+/// on that file (so Radiance computes with the data), its up the panel's,
+/// its window polygons facing into the room whatever way the model wound
+/// them.
+#[test]
+fn export_radiance_gives_bsdf_panels_their_data() {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("export_bsdf_room");
+    let _ = std::fs::remove_dir_all(&out);
+    let scene_path = bundled_scene("bsdf_room");
+    let args = ["export-radiance", scene_path.to_str().unwrap(), "--date", "2026-03-21", "--time", "10:00", "--out", out.to_str().unwrap()];
+    let run = heliodon(&args, &scratch());
+    assert_eq!(run.code, 0, "{}", run.err);
+    let rad = std::fs::read_to_string(out.join("scene.rad")).unwrap();
+    let blinds = std::fs::canonicalize(scene_path.parent().unwrap().join("../../bsdf/blinds.xml")).unwrap();
+    // The south windows: up is the zenith.
+    let material = format!("void BSDF m_upper_g0\n6 0 {} 0.000000000 0.000000000 1.000000000 .\n0\n0\n", blinds.display());
+    assert!(rad.contains(&material), "{rad}");
+    let polygons: Vec<&str> = rad.split("m_upper_g0 polygon ").skip(1).collect();
+    let scene = load_scene(&scene_path, &PanelCatalog::new().with(heliodon_bsdf::Bsdf)).unwrap().scene;
+    let upper = scene.materials.iter().position(|m| m.name == "upper").unwrap() as u32;
+    assert_eq!(polygons.len(), scene.triangles.iter().filter(|t| t.material == upper).count());
+    assert!(!polygons.is_empty());
+    for polygon in polygons {
+        let v: Vec<f64> = polygon.lines().skip(4).take(3).flat_map(|l| l.split_whitespace().map(|x| x.parse::<f64>().unwrap())).collect();
+        let (a, b) = ([v[3] - v[0], v[4] - v[1], v[5] - v[2]], [v[6] - v[0], v[7] - v[1], v[8] - v[2]]);
+        let normal_y = a[2] * b[0] - a[0] * b[2];
+        assert!(normal_y > 0.0, "a BSDF window faces into the room (+y): {polygon}");
+    }
+}
+
 // ---- annual ----------------------------------------------------------------------
 
 /// `annual` on the test room: every hour of `--hourly` is `sensors --sky

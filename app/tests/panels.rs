@@ -123,6 +123,34 @@ fn a_straight_lobe_passes_the_sun_as_an_opening_does() {
     }
 }
 
+/// A measured tensor tree (assets/bsdf/redirect_tt4.xml: the light's way
+/// mirrored in the panel's up axis) turns the low winter sun, which plain
+/// glass lays on the floor, up onto the ceiling: the tree's axes are the
+/// panel's frame (+z into the room, y up) end to end.
+#[test]
+fn a_redirecting_tensor_tree_sends_the_sun_to_the_ceiling() {
+    use std::sync::Arc;
+    let tree = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/bsdf/redirect_tt4.xml");
+    let direct_sun = |name: &str, window: &str| -> Vec<(String, f64)> {
+        let path = room(name, Some(window));
+        let mut text = std::fs::read_to_string(&path).unwrap();
+        for (k, y) in [2.5, 3.0, 3.5, 4.0].iter().enumerate() {
+            text.push_str(&format!("\n[[sensors]]\nname = \"ceiling-{k}\"\nposition = [2.0, {y}, 3.0]\nnormal = [0.0, 0.0, -1.0]\n"));
+        }
+        std::fs::write(&path, text).unwrap();
+        let scene = Arc::new(load_scene(&path, &all_panels()).unwrap().scene);
+        let model = heliodon::light::LightModel::precompute(scene.clone(), quick()).unwrap();
+        model.solve(&winter_noon(&scene), None).sensors.iter().map(|s| (s.name.clone(), s.direct_sun)).collect()
+    };
+    let sum = |readings: &[(String, f64)], surface: &str| readings.iter().filter(|r| r.0.starts_with(surface)).map(|r| r.1).sum::<f64>();
+    let glass = direct_sun("tree_glass", "panel = \"grey_filter\"\ntransmittance = 1.0\n");
+    let redirected = direct_sun("tree", &format!("panel = \"bsdf\"\nfile = \"{}\"\n", tree.display()));
+    assert!(sum(&glass, "floor") > 1000.0 && sum(&glass, "ceiling") == 0.0, "glass: {glass:?}");
+    assert!(sum(&redirected, "ceiling") > 1000.0, "the tree sends the sun up: {redirected:?}");
+    // What stays on the floor is the tree's diffuse rest, not a beam.
+    assert!(sum(&redirected, "floor") < 0.1 * sum(&redirected, "ceiling"), "{redirected:?}");
+}
+
 /// All the sun a prismatic window lets in lands inside the closed room:
 /// the direct sun on every patch side, times its area, adds up to the flux
 /// on the window times the panel's transmitted share.

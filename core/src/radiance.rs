@@ -2,14 +2,22 @@
 //! `run.sh` that renders the sensors' illuminance with oconv and rtrace, so
 //! any heliodon number can be checked against Radiance. The sky is written
 //! with heliodon's own arguments and sun (SPA angles), not regenerated.
+//! A panel fitted to measured data ([`PanelModel::bsdf_file`]) becomes
+//! Radiance's `BSDF` material on that data, one per window group: its up
+//! the panel frame's, its windows' polygons facing into the room (Radiance
+//! puts a BSDF's front, +z, on the normal's side; WINDOW's exterior "front"
+//! is its back). Other panels pass light straight through.
+//!
+//! [`PanelModel::bsdf_file`]: crate::panel::PanelModel::bsdf_file
 
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::light::sensor_points;
+use crate::light::{LightModel, PanelFrame, sensor_points};
 use crate::report::csv_field;
 use crate::scene::{MaterialKind, Scene};
 use crate::sky::{Sky, radiance_sky};
+use std::sync::Arc;
 
 /// rtrace settings of the reference runs in ../shared/validation: pure Monte
 /// Carlo, 16 bounces, converged well under 1%.
@@ -47,6 +55,49 @@ fn transmissivity(t: f64) -> f64 {
     crate::light::Glass::from_transmittance(t).transmissivity
 }
 
+/// The window groups of panels fitted to a BSDF file, and the group of
+/// every triangle in one.
+struct BsdfWindows {
+    groups: Vec<BsdfGroup>,
+    /// Per triangle of the scene: its index in `groups`.
+    of_triangle: Vec<Option<u32>>,
+}
+
+/// Windows of one BSDF panel material facing one way.
+struct BsdfGroup {
+    material: u32,
+    frame: PanelFrame,
+    /// The data file, absolute.
+    file: std::path::PathBuf,
+}
+
+impl BsdfWindows {
+    fn new(scene: &Scene) -> Self {
+        let mut out = Self { groups: Vec::new(), of_triangle: vec![None; scene.triangles.len()] };
+        let data = |material: u32| match &scene.materials[material as usize].kind {
+            MaterialKind::Panel { model, up, .. } => model.0.bsdf_file().map(|f| (f.to_path_buf(), *up)),
+            _ => None,
+        };
+        if (0..scene.materials.len() as u32).all(|m| data(m).is_none()) {
+            return out;
+        }
+        // The windows' outward sides are ray-tested, as the engine groups them.
+        let windows = LightModel::unlit(Arc::new(scene.clone())).windows;
+        for group in &windows.groups {
+            let Some((file, up)) = data(group.material) else { continue };
+            for &window in &group.windows {
+                let surface = &scene.surfaces[scene.windows[window as usize].surface as usize];
+                for t in surface.triangles.clone() {
+                    out.of_triangle[t as usize] = Some(out.groups.len() as u32);
+                }
+            }
+            let frame = PanelFrame::new(-group.outward, up.map(|u| u.as_dvec3()));
+            out.groups.push(BsdfGroup { material: group.material, frame, file: std::fs::canonicalize(&file).unwrap_or(file) });
+        }
+        out
+    }
+}
+
 /// Writes `scene.rad`, `sky.rad`, `sensors.pts`, `sensors.txt` (each
 /// sensor's name as a Radiance word and its number of points), `names.csv`
 /// (the names as they are, CSV fields) and `run.sh` into `dir`.
@@ -59,6 +110,11 @@ pub fn export(scene: &Scene, sky: &Sky, case: &str, dir: &Path) -> Result<(), St
     let mut rad = String::new();
     let _ = writeln!(rad, "# {} — exported by heliodon (metres, x east, y north, z up)\n", one_line(&scene.name));
     let ids = identifiers(scene);
+    let bsdf_windows = BsdfWindows::new(scene);
+    for (k, group) in bsdf_windows.groups.iter().enumerate() {
+        let (id, up) = (&ids[group.material as usize], group.frame.y);
+        let _ = writeln!(rad, "void BSDF {id}_g{k}\n6 0 {} {:.9} {:.9} {:.9} .\n0\n0\n", group.file.display(), up.x, up.y, up.z);
+    }
     for (material, id) in scene.materials.iter().zip(&ids) {
         match &material.kind {
             MaterialKind::Diffuse { reflectance } => {
@@ -69,16 +125,29 @@ pub fn export(scene: &Scene, sky: &Sky, case: &str, dir: &Path) -> Result<(), St
                 let tn = transmissivity(f64::from(*transmittance));
                 let _ = writeln!(rad, "void glass {id}\n0\n0\n3 {tn:.9} {tn:.9} {tn:.9}\n");
             }
+            MaterialKind::Panel { panel, model, .. } if model.0.bsdf_file().is_some() => {
+                let _ = writeln!(rad, "# panel '{panel}' ({id}): Radiance's BSDF on its data, one per window group (above)\n");
+            }
             MaterialKind::Panel { panel, .. } => {
-                // Panels pass light straight through in heliodon until their models land.
+                // Radiance cannot run heliodon's panel models.
                 let _ = writeln!(rad, "# panel '{panel}': exported as clear pass-through\nvoid trans {id}\n0\n0\n7 1 1 1 0 0 1 1\n");
             }
         }
     }
     for (i, t) in scene.triangles.iter().enumerate() {
-        let id = &ids[t.material as usize];
+        let mut vertices = t.vertices;
+        let id = match bsdf_windows.of_triangle[i] {
+            Some(group) => {
+                let inward = bsdf_windows.groups[group as usize].frame.z;
+                if t.cross().as_dvec3().dot(inward) < 0.0 {
+                    vertices.swap(1, 2);
+                }
+                format!("{}_g{group}", ids[t.material as usize])
+            }
+            None => ids[t.material as usize].clone(),
+        };
         let _ = writeln!(rad, "{id} polygon t{i}\n0\n0\n9");
-        for v in t.vertices {
+        for v in vertices {
             let _ = writeln!(rad, "  {:.6} {:.6} {:.6}", v.x, v.y, v.z);
         }
     }

@@ -65,6 +65,14 @@ pub trait PanelModel: Send + Sync + fmt::Debug {
     /// The response to light travelling along `incoming` (unit, panel frame;
     /// z > 0 for light from outside).
     fn response(&self, incoming: DVec3) -> PanelResponse;
+
+    /// The measured data the model was fitted to, as a file Radiance reads
+    /// with its `BSDF` material (LBNL BSDF XML): `export-radiance` then
+    /// lets Radiance compute with the data itself, not the lobes. `None`
+    /// (the default) for models that are their own geometry or formulas.
+    fn bsdf_file(&self) -> Option<&Path> {
+        None
+    }
 }
 
 /// A kind of panel, registered by name: builds models from scene-file keys.

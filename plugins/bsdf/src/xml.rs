@@ -1,10 +1,14 @@
-//! Reading LBNL BSDF XML (WINDOW6 format) with Klems angle bases through
-//! roxmltree: the elements heliodon needs, matched by local name (files
-//! carry WINDOW's namespace), with errors that name the file and line.
+//! Reading LBNL BSDF XML (WINDOW6 format) through roxmltree: matrices over
+//! Klems angle bases, or Radiance's tensor trees (`IncidentDataStructure`
+//! `TensorTree3`/`TensorTree4`, [`crate::tensor_tree`]); the elements
+//! heliodon needs, matched by local name (files carry WINDOW's namespace),
+//! with errors that name the file and line.
 
 use std::path::Path;
 
 use roxmltree::Node;
+
+use crate::tensor_tree::TensorTree;
 
 /// One ring of a Klems basis: its polar bounds (degrees) and φ divisions.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,15 +45,25 @@ impl Matrix {
     }
 }
 
-/// What heliodon uses of a BSDF file: the basis and, for light from
-/// outside, transmission and reflection (visible if given, else solar).
+/// What heliodon uses of a BSDF file: for light from outside, its
+/// transmission and reflection (visible if given, else solar).
 #[derive(Debug, Clone)]
 pub struct BsdfFile {
-    pub basis: Basis,
-    pub transmission: Matrix,
-    pub reflection: Option<Matrix>,
+    pub scattering: Scattering,
     /// "Visible" or "Solar".
     pub wavelength: String,
+}
+
+/// The scattering data of a file, as its kind keeps it.
+#[derive(Debug, Clone)]
+pub enum Scattering {
+    /// Matrices over a Klems basis.
+    Klems { basis: Basis, transmission: Matrix, reflection: Option<Matrix> },
+    /// Tensor trees (Radiance's frame: +z into the room). `transmission`
+    /// is "Transmission Front" (light from outside), or, when only the
+    /// back one is given, "Transmission Back" read by reciprocity
+    /// (`reciprocal`: query it with the two directions exchanged).
+    TensorTree { transmission: TensorTree, reciprocal: bool, reflection: Option<TensorTree> },
 }
 
 /// Klems bases have 145 patches at most (the full basis); this leaves room
@@ -88,6 +102,34 @@ impl<'a, 'i> Reader<'a, 'i> {
         node.text().unwrap_or("").trim().to_string()
     }
 
+    /// Every `<WavelengthDataBlock>`: its wavelength, direction and node;
+    /// a scattering data type other than BTDF or BRDF is refused.
+    fn blocks(&self) -> Result<Vec<(String, String, Node<'a, 'i>)>, String> {
+        let mut blocks = Vec::new();
+        for data in self.doc.root_element().descendants().filter(|n| n.has_tag_name("WavelengthData")) {
+            let wavelength = Self::content(self.required(data, "Wavelength")?);
+            for block in data.children().filter(|n| n.has_tag_name("WavelengthDataBlock")) {
+                let direction = Self::content(self.required(block, "WavelengthDataDirection")?);
+                if let Some(kind) = Self::child(block, "ScatteringDataType")
+                    && !Self::content(kind).eq_ignore_ascii_case("BTDF")
+                    && !Self::content(kind).eq_ignore_ascii_case("BRDF")
+                {
+                    return Err(format!("{}: scattering data type '{}' is not supported", self.at(kind), Self::content(kind)));
+                }
+                blocks.push((wavelength.clone(), direction, block));
+            }
+        }
+        Ok(blocks)
+    }
+
+    /// A block's `<ScatteringData>`, its text and the text's byte offset
+    /// (to place a bad value on its own line).
+    fn scattering_text(&self, block: Node<'a, 'i>) -> Result<(Node<'a, 'i>, &'a str, usize), String> {
+        let data = self.required(block, "ScatteringData")?;
+        let (text, start) = data.first_child().map_or(("", data.range().start), |t| (t.text().unwrap_or(""), t.range().start));
+        Ok((data, text, start))
+    }
+
     fn number(&self, node: Node, what: &str) -> Result<f64, String> {
         let value = Self::content(node);
         value
@@ -113,13 +155,31 @@ pub fn parse(text: &str, file: &Path) -> Result<BsdfFile, String> {
     })?;
     let r = Reader { doc: &doc, file, skipped_lines };
     let root = doc.root_element();
-    // The angle basis (tensor trees have none, or a non-Klems one).
+    let structure = root.descendants().find(|n| n.has_tag_name("IncidentDataStructure")).map(Reader::content);
+    match structure.as_deref() {
+        Some("TensorTree3") => tensor_trees(&r, 3),
+        Some("TensorTree4") => tensor_trees(&r, 4),
+        Some(other) if !matches!(other, "Rows" | "Columns") => Err(format!(
+            "{}: IncidentDataStructure '{other}' is not one heliodon reads (Columns or Rows over a Klems basis, TensorTree3 or TensorTree4)",
+            file.display()
+        )),
+        _ => klems(&r, structure.as_deref() == Some("Rows")),
+    }
+}
+
+/// The matrices of a file over a Klems basis (`rows_incident`: rows list
+/// incoming directions).
+fn klems(r: &Reader, rows_incident: bool) -> Result<BsdfFile, String> {
+    let (root, file) = (r.doc.root_element(), r.file);
     let Some(basis_element) = root.descendants().find(|n| n.has_tag_name("AngleBasis")) else {
-        return Err(format!("{}: no <AngleBasis>: tensor-tree BSDFs are not supported yet (use a Klems basis)", file.display()));
+        return Err(format!("{}: no <AngleBasis> and no tensor tree (IncidentDataStructure TensorTree3 or TensorTree4)", file.display()));
     };
     let name = Reader::content(r.required(basis_element, "AngleBasisName")?);
     if !name.contains("Klems") {
-        return Err(format!("{}: angle basis '{name}' is not a Klems basis (tensor trees are not supported yet)", r.at(basis_element)));
+        return Err(format!(
+            "{}: angle basis '{name}' is not a Klems basis (nor is the file a tensor tree: IncidentDataStructure TensorTree3 or TensorTree4)",
+            r.at(basis_element)
+        ));
     }
     let mut rings = Vec::new();
     for block in basis_element.children().filter(|n| n.has_tag_name("AngleBasisBlock")) {
@@ -149,54 +209,40 @@ pub fn parse(text: &str, file: &Path) -> Result<BsdfFile, String> {
             basis.name
         ));
     }
-    let rows_incident = root.descendants().find(|n| n.has_tag_name("IncidentDataStructure")).is_some_and(|e| Reader::content(e) == "Rows");
     // Scattering blocks by wavelength and direction.
     let mut blocks: Vec<(String, String, Matrix)> = Vec::new();
-    for data in root.descendants().filter(|n| n.has_tag_name("WavelengthData")) {
-        let wavelength = Reader::content(r.required(data, "Wavelength")?);
-        for block in data.children().filter(|n| n.has_tag_name("WavelengthDataBlock")) {
-            let direction = Reader::content(r.required(block, "WavelengthDataDirection")?);
-            if let Some(kind) = Reader::child(block, "ScatteringDataType")
-                && !Reader::content(kind).eq_ignore_ascii_case("BTDF")
-                && !Reader::content(kind).eq_ignore_ascii_case("BRDF")
-            {
-                return Err(format!("{}: scattering data type '{}' is not supported", r.at(kind), Reader::content(kind)));
-            }
-            let data = r.required(block, "ScatteringData")?;
-            // The text node, to place a bad value on its own line.
-            let (values_text, values_start) =
-                data.first_child().map_or(("", data.range().start), |t| (t.text().unwrap_or(""), t.range().start));
-            let mut values = Vec::with_capacity(n * n);
-            for token in values_text.split(|c: char| c.is_whitespace() || c == ',').filter(|t| !t.is_empty()) {
-                match token.parse::<f64>() {
-                    Ok(v) if v.is_finite() => values.push(v.max(0.0)),
-                    _ => {
-                        let offset = values_start + (token.as_ptr() as usize - values_text.as_ptr() as usize);
-                        return Err(format!("{}:{}: scattering value '{token}' is not a finite number", file.display(), r.line(offset)));
-                    }
+    for (wavelength, direction, block) in r.blocks()? {
+        let (data, values_text, values_start) = r.scattering_text(block)?;
+        let mut values = Vec::with_capacity(n * n);
+        for token in values_text.split(|c: char| c.is_whitespace() || c == ',').filter(|t| !t.is_empty()) {
+            match token.parse::<f64>() {
+                Ok(v) if v.is_finite() => values.push(v.max(0.0)),
+                _ => {
+                    let offset = values_start + (token.as_ptr() as usize - values_text.as_ptr() as usize);
+                    return Err(format!("{}:{}: scattering value '{token}' is not a finite number", file.display(), r.line(offset)));
                 }
             }
-            if values.len() != n * n {
-                return Err(format!(
-                    "{}: {direction} ({wavelength}) has {} values; basis '{}' needs {n} × {n} = {}",
-                    r.at(data),
-                    values.len(),
-                    basis.name,
-                    n * n
-                ));
-            }
-            if rows_incident {
-                // Rows list incoming directions: transpose to outgoing-major.
-                let mut transposed = vec![0.0; n * n];
-                for (k, v) in values.iter().enumerate() {
-                    transposed[(k % n) * n + k / n] = *v;
-                }
-                values = transposed;
-            }
-            blocks.push((wavelength.clone(), direction, Matrix { incoming: n, values }));
         }
+        if values.len() != n * n {
+            return Err(format!(
+                "{}: {direction} ({wavelength}) has {} values; basis '{}' needs {n} × {n} = {}",
+                r.at(data),
+                values.len(),
+                basis.name,
+                n * n
+            ));
+        }
+        if rows_incident {
+            // Rows list incoming directions: transpose to outgoing-major.
+            let mut transposed = vec![0.0; n * n];
+            for (k, v) in values.iter().enumerate() {
+                transposed[(k % n) * n + k / n] = *v;
+            }
+            values = transposed;
+        }
+        blocks.push((wavelength.clone(), direction, Matrix { incoming: n, values }));
     }
-    let wavelength = if blocks.iter().any(|b| b.0 == "Visible") { "Visible" } else { "Solar" };
+    let wavelength = photometric(&blocks);
     let find = |direction: &str| blocks.iter().find(|b| b.0 == wavelength && b.1 == direction).map(|b| b.2.clone());
     let transmission = match find("Transmission Front") {
         Some(matrix) => matrix,
@@ -212,5 +258,45 @@ pub fn parse(text: &str, file: &Path) -> Result<BsdfFile, String> {
             Matrix { incoming: n, values }
         }
     };
-    Ok(BsdfFile { basis, transmission, reflection: find("Reflection Front"), wavelength: wavelength.to_string() })
+    let scattering = Scattering::Klems { basis, transmission, reflection: find("Reflection Front") };
+    Ok(BsdfFile { scattering, wavelength: wavelength.to_string() })
+}
+
+/// The tensor trees of a file of `dims` (3 or 4) dimensions.
+fn tensor_trees(r: &Reader, dims: usize) -> Result<BsdfFile, String> {
+    let mut blocks: Vec<(String, String, TensorTree)> = Vec::new();
+    for (wavelength, direction, block) in r.blocks()? {
+        // CIE-u and CIE-v trees colour the light; heliodon's panels are grey.
+        if !matches!(wavelength.as_str(), "Visible" | "Solar") {
+            continue;
+        }
+        let basis = r.required(block, "AngleBasis")?;
+        if Reader::content(basis) != "LBNL/Shirley-Chiu" {
+            return Err(format!(
+                "{}: a tensor tree's angle basis must be LBNL/Shirley-Chiu, not '{}'",
+                r.at(basis),
+                Reader::content(basis)
+            ));
+        }
+        let (_, text, start) = r.scattering_text(block)?;
+        let tree = TensorTree::parse(text, dims).map_err(|(at, why)| format!("{}:{}: {why}", r.file.display(), r.line(start + at)))?;
+        blocks.push((wavelength, direction, tree));
+    }
+    let wavelength = photometric(&blocks);
+    let mut find = |direction: &str| {
+        let found = blocks.iter().position(|b| b.0 == wavelength && b.1 == direction);
+        found.map(|k| blocks.swap_remove(k).2)
+    };
+    let reflection = find("Reflection Front");
+    let (transmission, reciprocal) = match (find("Transmission Front"), find("Transmission Back")) {
+        (Some(front), _) => (front, false),
+        (None, Some(back)) => (back, true),
+        (None, None) => return Err(format!("{}: no transmission tree ({wavelength})", r.file.display())),
+    };
+    Ok(BsdfFile { scattering: Scattering::TensorTree { transmission, reciprocal, reflection }, wavelength: wavelength.to_string() })
+}
+
+/// "Visible" when a file has visible data, else "Solar".
+fn photometric<T>(blocks: &[(String, String, T)]) -> &'static str {
+    if blocks.iter().any(|b| b.0 == "Visible") { "Visible" } else { "Solar" }
 }
