@@ -151,6 +151,64 @@ fn a_redirecting_tensor_tree_sends_the_sun_to_the_ceiling() {
     assert!(sum(&redirected, "floor") < 0.1 * sum(&redirected, "ceiling"), "{redirected:?}");
 }
 
+/// A panel's room side returns its back reflectance of the room's light:
+/// an opaque panel (transmittance 0) reflecting half of it back lights the
+/// room as a diffuse wall of reflectance 0.5 in its place does, and one
+/// that returns nothing leaves the room darker.
+#[test]
+fn a_panel_reflects_the_rooms_light_back_as_a_wall_would() {
+    use std::sync::Arc;
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("panel_back_reflectance");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut obj = QuadObj::new("room.mtl");
+    let (w, d, h) = (4.0, 6.0, 3.0);
+    obj.quad("floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
+    obj.quad("wall", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
+    obj.quad("wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
+    obj.quad("wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
+    // The south wall around a glass window (x 1-3, z 1-2), the north wall
+    // around the "blind" (x 0.5-3.5, z 0.5-2.5).
+    for (y, (x0, x1, z0, z1), name) in [(0.0, (1.0, 3.0, 1.0, 2.0), "glass"), (d, (0.5, 3.5, 0.5, 2.5), "blind")] {
+        obj.quad("wall", [[0.0, y, 0.0], [w, y, 0.0], [w, y, z0], [0.0, y, z0]]);
+        obj.quad("wall", [[0.0, y, z1], [w, y, z1], [w, y, h], [0.0, y, h]]);
+        obj.quad("wall", [[0.0, y, z0], [x0, y, z0], [x0, y, z1], [0.0, y, z1]]);
+        obj.quad("wall", [[x1, y, z0], [w, y, z0], [w, y, z1], [x1, y, z1]]);
+        obj.quad(name, [[x0, y, z0], [x1, y, z0], [x1, y, z1], [x0, y, z1]]);
+    }
+    std::fs::write(dir.join("room.obj"), obj.text()).unwrap();
+    let mtl = "newmtl floor\nKd 0.2 0.2 0.2\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.12\nnewmtl blind\nKd 0.5 0.5 0.5\n";
+    std::fs::write(dir.join("room.mtl"), mtl).unwrap();
+    let indirect = |name: &str, blind: &str| -> Vec<f64> {
+        let mut text = format!(
+            "name = \"{name}\"\n[site]\nlatitude = 42.36\nlongitude = -71.06\ntimezone = -5.0\n[model]\nobj = \"room.obj\"\n{blind}"
+        );
+        for (k, y) in [1.0, 2.5, 4.0, 5.5].iter().enumerate() {
+            text.push_str(&format!("\n[[sensors]]\nname = \"s{k}\"\nposition = [2.0, {y}, 0.8]\nnormal = [0.0, 0.0, 1.0]\n"));
+        }
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, text).unwrap();
+        let scene = Arc::new(load_scene(&path, &all_panels()).unwrap().scene);
+        let model = heliodon::light::LightModel::precompute(scene.clone(), quick()).unwrap();
+        let sky = heliodon::sky::Sky::new(&heliodon::sky::SkySpec::Overcast, 45.0, 180.0, 0.2, 355).unwrap();
+        model.solve(&sky, None).sensors.iter().map(|s| s.indirect).collect()
+    };
+    let wall = indirect("wall", "");
+    let panel = |rho: f64| {
+        format!("\n[materials.blind]\nkind = \"panel\"\npanel = \"grey_filter\"\ntransmittance = 0.0\nback_reflectance = {rho}\n")
+    };
+    let reflecting = indirect("reflecting", &panel(0.5));
+    let dark = indirect("dark", &panel(0.0));
+    for ((w, r), d) in wall.iter().zip(&reflecting).zip(&dark) {
+        println!("indirect: wall {w:.2}, reflecting panel {r:.2}, dark panel {d:.2}");
+    }
+    for ((w, r), d) in wall.iter().zip(&reflecting).zip(&dark) {
+        assert!((r / w - 1.0).abs() < 0.02, "a panel returning 0.5 lights the room as a 0.5 wall: {r} vs {w}");
+        assert!(d < w, "a panel returning nothing leaves the room darker: {d} vs {w}");
+    }
+    // Most of all beside it.
+    assert!(dark[3] < 0.8 * wall[3], "{dark:?} vs {wall:?}");
+}
+
 /// All the sun a prismatic window lets in lands inside the closed room:
 /// the direct sun on every patch side, times its area, adds up to the flux
 /// on the window times the panel's transmitted share.

@@ -17,7 +17,9 @@
 //!    (the sun's beams and the sky's transfer), not how rays cross them (a
 //!    panel passes gather rays unweighted), so one precomputation and one
 //!    set of sensor coefficients serve every combination: only the panel
-//!    model is swapped ([`LightModel::set_panel_model`]). At an instant a
+//!    model is swapped ([`LightModel::set_panel_model`]; the coefficients
+//!    are solved again only where a combination changes how much light the
+//!    panel reflects back into the room). At an instant a
 //!    combination is one coefficient reading; over a year one sun path and
 //!    a year of readings. A glass's transmittance changes every ray that
 //!    crosses it: each combination is precomputed anew.
@@ -276,6 +278,7 @@ pub fn sweep(
     each: &dyn Fn(&Outcome, f64),
 ) -> Vec<Outcome> {
     let coefficients = variation.is_panel().then(|| model.sensor_coefficients());
+    let back_reflectance = model.panel_back_reflectance(variation.material);
     let total = range.len().max(1);
     range
         .enumerate()
@@ -284,7 +287,12 @@ pub fn sweep(
             let result = variation.material(grid, &values).and_then(|material| match (&material.kind, &coefficients) {
                 (MaterialKind::Panel { model: panel, .. }, Some(coefficients)) => {
                     model.set_panel_model(variation.material, panel.0.clone());
-                    evaluate(model, coefficients, sensors, target)
+                    if model.panel_back_reflectance(variation.material) == back_reflectance {
+                        evaluate(model, coefficients, sensors, target)
+                    } else {
+                        // The room's interreflection changed with the panel's back.
+                        evaluate(model, &model.sensor_coefficients(), sensors, target)
+                    }
                 }
                 _ => {
                     let mut scene = (*model.scene).clone();

@@ -47,7 +47,9 @@ const BLOCK: usize = 32;
 /// model. They hold for the model they were made from and for any that
 /// differs from it only in panel models ([`LightModel::set_panel_model`]:
 /// panels change what the sky and sun send through the windows, not how
-/// the room passes it on), which is what sweeps of panel keys rely on.
+/// the room passes it on), which is what sweeps of panel keys rely on, as
+/// long as the panels reflect the room's light back as before
+/// ([`LightModel::panel_back_reflectance`]).
 pub struct SensorCoefficients {
     sensors: usize,
     slots: RadianceSlots,

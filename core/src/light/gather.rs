@@ -198,7 +198,13 @@ impl LightModel {
                 let crossed = window.or(self.window_of_surface[self.scene.patches.patches[hit.patch as usize].surface as usize]);
                 match self.surface_of_patch(hit.patch) {
                     Surface::Diffuse(_) => hits.push(SideHit { side: side_of(hit.patch, cos > 0.0), weight, point }),
-                    Surface::Panel(_) if depth < MAX_GLASS_DEPTH => {
+                    Surface::Panel(group) if depth < MAX_GLASS_DEPTH => {
+                        // From the room the ray meets the panel's room side too
+                        // (what it reflects back), and passes on.
+                        let side = side_of(hit.patch, cos > 0.0);
+                        if self.panel_room_side(hit.patch, group) == Some(side) {
+                            hits.push(SideHit { side, weight, point });
+                        }
                         self.follow(point + dir * SURFACE_OFFSET, dir, weight, depth + 1, crossed, coefficients, hits)
                     }
                     Surface::Glass(glass) if depth < MAX_GLASS_DEPTH => {
@@ -218,13 +224,21 @@ impl LightModel {
     }
 
     /// One patch side's gather: cosine-weighted rays from points spread over
-    /// the patch, each receiver with its own seeded generator.
+    /// the patch, each receiver with its own seeded generator. Diffuse
+    /// sides and panels' room sides gather (whatever the panel's back
+    /// reflectance: a sweep may change it), glass and panels' outer sides
+    /// do not.
     fn gather_patch_side(&self, side: usize) -> Gather {
         let patch_index = side / 2;
-        let patch = &self.scene.patches.patches[patch_index];
-        if !matches!(self.surfaces[patch.material as usize], Surface::Diffuse(_)) {
+        let gathers = match self.surface_of_patch(patch_index as u32) {
+            Surface::Diffuse(_) => true,
+            Surface::Panel(group) => self.panel_room_side(patch_index as u32, group) == Some(side as u32),
+            Surface::Glass(_) => false,
+        };
+        if !gathers {
             return Gather::default();
         }
+        let patch = &self.scene.patches.patches[patch_index];
         let normal = patch.normal.as_dvec3() * if side % 2 == 1 { -1.0 } else { 1.0 };
         let triangles = self.patch_triangles(patch_index);
         let mut rng = Rng::new(1, side as u64);

@@ -74,6 +74,8 @@ enum Surface {
     /// A panel window of this group: rays pass on (what they see beyond is
     /// turned into the panel's light at relight time, see
     /// `PanelGroup::radiance_through`); the sun passes only along its lobes.
+    /// Its room side also reflects the room's light back (its group's
+    /// `back_reflectance`): a ray from the room meets that side and passes.
     Panel(u32),
 }
 
@@ -99,7 +101,7 @@ pub struct LightModel {
     group_of_surface: Vec<Option<u32>>,
     /// Where the sun can come in (spares shadow rays).
     openings: openings::Openings,
-    /// Per patch side (2 per patch; empty for glass and panels).
+    /// Per patch side (2 per patch; empty for glass and the outer side of panels).
     side_gathers: Vec<Gather>,
     sensors: Vec<SensorGeometry>,
 }
@@ -286,12 +288,23 @@ impl LightModel {
         gather.daylight_coefficients.first().is_some_and(|&(k, _)| SkyKey::unpack(k, self.bin_count()).window.is_none())
     }
 
-    /// The diffuse reflectance (RGB) of a patch side; `None` for glass and panels.
+    /// The diffuse reflectance (RGB) of a patch side; `None` for glass, the
+    /// outer side of panels and panels that reflect nothing back.
     fn side_reflectance(&self, side: usize) -> Option<[f64; 3]> {
-        match self.surfaces[self.scene.patches.patches[side / 2].material as usize] {
+        match self.surface_of_patch((side / 2) as u32) {
             Surface::Diffuse(rho) => Some(rho),
+            Surface::Panel(group) if self.panel_room_side((side / 2) as u32, group) == Some(side as u32) => {
+                let rho = self.panel_groups[group as usize].back_reflectance;
+                (rho > 0.0).then_some([rho; 3])
+            }
             _ => None,
         }
+    }
+
+    /// The side of a panel patch (of `group`) that faces the room.
+    fn panel_room_side(&self, patch: u32, group: u32) -> Option<u32> {
+        let inward = self.panel_groups.get(group as usize)?.frame.z;
+        Some(side_of(patch, self.patch_normal(patch).dot(inward) < 0.0))
     }
 
     /// Bins of the sky sphere (sky above the horizon, ground below).
@@ -303,11 +316,18 @@ impl LightModel {
     /// into [`Scene::materials`]): what the sky and sun send through them
     /// changes, the gathered transport does not (rays pass panels
     /// unweighted), so a sweep of panel keys keeps one precomputation.
-    /// `scene.materials` keeps the file's keys.
+    /// (Sensor coefficients also hold while the back reflectance stays:
+    /// [`Self::panel_back_reflectance`].) `scene.materials` keeps the file's keys.
     pub fn set_panel_model(&mut self, material: u32, model: Arc<dyn crate::panel::PanelModel>) {
         for group in self.panel_groups.iter_mut().filter(|g| g.material == material) {
             group.set_model(model.clone());
         }
+    }
+
+    /// The back reflectance of panel material `material`'s windows, as the
+    /// model in them gives it; `None` when no window has that material.
+    pub fn panel_back_reflectance(&self, material: u32) -> Option<f64> {
+        self.panel_groups.iter().find(|g| g.material == material).map(|g| g.back_reflectance)
     }
 
     /// Which panel group a surface's windows belong to.

@@ -10,7 +10,7 @@ use std::sync::{Arc, OnceLock};
 use glam::DVec3;
 
 use super::windows::WindowGroups;
-use crate::panel::PanelModel;
+use crate::panel::{Lobe, PanelModel};
 use crate::scene::{MaterialKind, Scene};
 use crate::sky::{SkyPatches, SunSource};
 
@@ -54,12 +54,15 @@ pub struct PanelGroup {
     pub model: Arc<dyn PanelModel>,
     /// The frame shared by the group's windows.
     pub frame: PanelFrame,
+    /// The model's [`PanelModel::back_reflectance`], clamped to 0-1: the
+    /// windows' room side is a diffuse reflector of it.
+    pub back_reflectance: f64,
     /// How sky and ground light pass it, made on first use.
     transfer: OnceLock<SkyTransfer>,
 }
 
 /// How a panel group passes sky and ground light, per sphere bin the light
-/// comes from: the bins its lobes leave along, as factors from the
+/// comes from: the bins its lobes' beams ([`spread`]) leave along, as factors from the
 /// incoming bin's radiance to the radiance seen through the panel in the
 /// outgoing bin (share · cos θin · ωin / (cos θout · ωout)), and the factor
 /// to the radiance of its diffuse transmission (τd · cos θin · ωin / π).
@@ -74,6 +77,7 @@ pub struct SkyTransfer {
 impl PanelGroup {
     /// Another model for the group's windows; its sky transfer is made anew.
     pub fn set_model(&mut self, model: Arc<dyn PanelModel>) {
+        self.back_reflectance = back_reflectance(model.as_ref());
         self.model = model;
         self.transfer = OnceLock::new();
     }
@@ -100,10 +104,11 @@ impl PanelGroup {
                     .lobes
                     .iter()
                     .filter(|l| l.direction.z > 1e-6 && l.share > 0.0)
-                    .map(|lobe| {
-                        // Seen from the room, looking back against the lobe.
-                        let out = bins.sphere_bin(-self.frame.to_world(lobe.direction));
-                        (out as u32, lobe.share * flux / (lobe.direction.z * solid_angle(out)))
+                    .flat_map(spread)
+                    .map(|(direction, share)| {
+                        // Seen from the room, looking back against the beam.
+                        let out = bins.sphere_bin(-self.frame.to_world(direction));
+                        (out as u32, share * flux / (direction.z * solid_angle(out)))
                     })
                     .collect();
                 (lobes, response.diffuse_transmittance * flux / std::f64::consts::PI)
@@ -167,15 +172,64 @@ pub fn panel_groups(scene: &Scene, windows: &WindowGroups) -> (Vec<PanelGroup>, 
         for &window in &window_group.windows {
             group_of_surface[scene.windows[window as usize].surface as usize] = Some(groups.len() as u32);
         }
-        groups.push(PanelGroup { material: window_group.material, model: model.0.clone(), frame, transfer: OnceLock::new() });
+        let back_reflectance = back_reflectance(model.0.as_ref());
+        groups.push(PanelGroup {
+            material: window_group.material,
+            model: model.0.clone(),
+            frame,
+            back_reflectance,
+            transfer: OnceLock::new(),
+        });
     }
     (groups, group_of_surface)
 }
 
+/// A model's back reflectance, a finite share (a plugin's bad value reads 0).
+fn back_reflectance(model: &dyn PanelModel) -> f64 {
+    let rho = model.back_reflectance();
+    if rho.is_finite() { rho.clamp(0.0, 1.0) } else { 0.0 }
+}
+
+/// Lobes at least this wide (full angle, degrees) are spread over their cone.
+pub const SPREAD_WIDTH: f64 = 4.0;
+
+/// Beams a wide lobe is spread into, on a ring around its direction.
+const RING: usize = 3;
+
+/// The directions (panel frame) and shares a lobe's light travels in: the
+/// lobe itself when it is narrower than [`SPREAD_WIDTH`]; else three beams
+/// on a ring around its direction at 1/√2 of the cone's half angle, a
+/// third of the share each: their mean is the lobe's direction and their
+/// spread (the mean squared angle from it, the same across every axis)
+/// that of light filling the cone of the lobe's width evenly. Three, not
+/// more, because each beam is a pass pair of the renderer's sun pass. The
+/// ring starts toward the panel's x axis; beams that would leave below the
+/// panel's plane are dropped and the others carry the lobe.
+pub fn spread(lobe: &Lobe) -> Vec<(DVec3, f64)> {
+    let centre = lobe.direction.normalize();
+    // (A NaN width reads as narrow.)
+    if lobe.width.is_nan() || lobe.width < SPREAD_WIDTH {
+        return vec![(centre, lobe.share)];
+    }
+    let (sin, cos) = ((0.5 * lobe.width.min(180.0)).to_radians() * std::f64::consts::FRAC_1_SQRT_2).sin_cos();
+    let across = (DVec3::X - centre * centre.x).try_normalize().unwrap_or_else(|| (DVec3::Y - centre * centre.y).normalize());
+    let (u, v) = (across, centre.cross(across));
+    let ring = (0..RING).map(|k| {
+        let (s, c) = (std::f64::consts::TAU * k as f64 / RING as f64).sin_cos();
+        centre * cos + (u * c + v * s) * sin
+    });
+    let directions: Vec<DVec3> = ring.filter(|d| d.z > 1e-6).collect();
+    if directions.is_empty() {
+        return vec![(centre, lobe.share)];
+    }
+    let share = lobe.share / directions.len() as f64;
+    directions.into_iter().map(|d| (d, share)).collect()
+}
+
 /// The beams of direct sunlight for a sun: the sun, and for each panel
-/// group its transmitted lobes. A lobe carries the flux the panel's area
-/// receives (E · cos θin) times its share, spread over the beam's cross
-/// section (÷ cos θout).
+/// group its transmitted lobes, each as the beams it [`spread`]s into. A
+/// beam carries the flux the panel's area receives (E · cos θin) times its
+/// share, spread over the beam's cross section (÷ cos θout).
 pub fn sun_beams(groups: &[PanelGroup], sun: &SunSource) -> Vec<SunBeam> {
     let mut beams = vec![SunBeam { to_light: sun.direction, normal_irradiance: sun.normal_irradiance(), panel_group: None }];
     for (index, group) in groups.iter().enumerate() {
@@ -184,12 +238,13 @@ pub fn sun_beams(groups: &[PanelGroup], sun: &SunSource) -> Vec<SunBeam> {
             continue;
         }
         for lobe in group.model.response(incoming).lobes.iter().filter(|l| l.direction.z > 1e-6 && l.share > 0.0) {
-            let out = group.frame.to_world(lobe.direction).normalize();
-            beams.push(SunBeam {
-                to_light: -out,
-                normal_irradiance: sun.normal_irradiance() * incoming.z * lobe.share / lobe.direction.z,
-                panel_group: Some(index as u32),
-            });
+            for (direction, share) in spread(lobe) {
+                beams.push(SunBeam {
+                    to_light: -group.frame.to_world(direction).normalize(),
+                    normal_irradiance: sun.normal_irradiance() * incoming.z * share / direction.z,
+                    panel_group: Some(index as u32),
+                });
+            }
         }
     }
     beams
@@ -198,6 +253,29 @@ pub fn sun_beams(groups: &[PanelGroup], sun: &SunSource) -> Vec<SunBeam> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A wide lobe's beams carry its share, centred on it, spread as light
+    /// filling its cone evenly (mean squared angle (w/2)²/2); a narrow lobe
+    /// stays one beam; a lobe near the panel's plane keeps its share in the
+    /// beams left above it.
+    #[test]
+    fn wide_lobes_spread_over_their_cone_and_keep_their_share() {
+        let tilted = DVec3::new(0.3, -0.5, 0.81).normalize();
+        for width in [4.0, 23.0, 40.0] {
+            let beams = spread(&Lobe { direction: tilted, share: 0.42, width });
+            assert_eq!(beams.len(), 3);
+            assert!((beams.iter().map(|b| b.1).sum::<f64>() - 0.42).abs() < 1e-12);
+            let mean: DVec3 = beams.iter().map(|b| b.0 * b.1).sum();
+            assert!(mean.normalize().angle_between(tilted) < 1e-6, "{width}");
+            let spread_sq = beams.iter().map(|b| b.0.angle_between(tilted).powi(2) * b.1).sum::<f64>() / 0.42;
+            let half = (0.5 * width).to_radians();
+            assert!((spread_sq / (0.5 * half * half) - 1.0).abs() < 0.01, "{width}: {spread_sq}");
+        }
+        assert_eq!(spread(&Lobe { direction: tilted, share: 0.42, width: 2.0 }), vec![(tilted, 0.42)]);
+        let grazing = spread(&Lobe { direction: DVec3::new(0.0, 0.999, 0.045).normalize(), share: 0.3, width: 30.0 });
+        assert!(grazing.len() < 3 && grazing.iter().all(|b| b.0.z > 0.0));
+        assert!((grazing.iter().map(|b| b.1).sum::<f64>() - 0.3).abs() < 1e-12);
+    }
 
     #[test]
     fn frames_are_right_handed_with_up_in_the_plane() {

@@ -29,6 +29,8 @@ pub struct Lobe {
     /// Share of the incoming flux (0-1).
     pub share: f64,
     /// Angular width: the full angle of the cone it spreads over, degrees.
+    /// The light engine (and the renderer with it) spreads a lobe of 4° or
+    /// more over that cone as three beams; a narrower one is one beam.
     pub width: f64,
 }
 
@@ -65,6 +67,13 @@ pub trait PanelModel: Send + Sync + fmt::Debug {
     /// The response to light travelling along `incoming` (unit, panel frame;
     /// z > 0 for light from outside).
     fn response(&self, incoming: DVec3) -> PanelResponse;
+
+    /// The share of the room's light falling on the panel that it reflects
+    /// back into the room (diffusely, averaged over the hemisphere): blinds
+    /// return a good part of it. 0 by default: it all leaves or is absorbed.
+    fn back_reflectance(&self) -> f64 {
+        0.0
+    }
 
     /// The measured data the model was fitted to, as a file Radiance reads
     /// with its `BSDF` material (LBNL BSDF XML): `export-radiance` then

@@ -17,6 +17,11 @@
 //! solid angle (the Shirley–Chiu square), each the mean of the tree's
 //! leaves over the bin.
 //!
+//! Each lobe is as wide as the light it stands for (2√2 times the RMS angle
+//! of its flux, the bins' own extent included, at most the cone), so the
+//! engine spreads it as the data does; "Reflection Back" gives the share of
+//! the room's light the panel returns to it.
+//!
 //! Scene-file keys (`kind = "panel"`, `panel = "bsdf"`): `file` (relative
 //! to the scene file), `lobes` (k, 1-8, default 3), `lobe_width` (α in
 //! degrees, 1-90, default 23).
@@ -83,6 +88,12 @@ pub fn klems_patches(basis: &Basis) -> Vec<(DVec3, f64)> {
     out
 }
 
+/// The solid angles of a Klems basis's patches, 2π(cos θlo − cos θhi)/nφ.
+fn klems_solid_angles(basis: &Basis) -> Vec<f64> {
+    let ring = |r: &xml::Ring| std::f64::consts::TAU * (r.theta_low.to_radians().cos() - r.theta_high.to_radians().cos()) / r.phis as f64;
+    basis.rings.iter().flat_map(|r| std::iter::repeat_n(ring(r), r.phis)).collect()
+}
+
 /// The fitted response to one measured incoming direction.
 #[derive(Debug, Clone)]
 struct Fitted {
@@ -103,11 +114,15 @@ fn cones(directions: &[DVec3], width: f64) -> Vec<Vec<u32>> {
 }
 
 /// Greedy lobe selection (thesis algorithm 2) over the transmitted flux
-/// `flux[o]` of the outgoing bins: `count` lobes, each the cone of full
-/// angle `width` ([`cones`]) holding the most flux (its direction the
-/// flux-weighted mean), whose bins are then zeroed. Returns the lobes and
-/// what no lobe took.
-fn greedy_lobes(flux: &[f64], directions: &[DVec3], cones: &[Vec<u32>], count: usize, width: f64) -> (Vec<Lobe>, f64) {
+/// `flux[o]` of the outgoing bins (`bins`: their directions and solid
+/// angles): `count` lobes, each the cone of full angle `width` ([`cones`])
+/// holding the most flux (its direction the flux-weighted mean), whose
+/// bins are then zeroed. A lobe's width is the spread of that flux: 2√2
+/// times its RMS angle from the lobe's direction (each bin's own extent,
+/// Ω/2π, included), as light filling a cone that wide evenly would have;
+/// `width` at most. Returns the lobes and what no lobe took.
+fn greedy_lobes(flux: &[f64], bins: &Bins, cones: &[Vec<u32>], count: usize, width: f64) -> (Vec<Lobe>, f64) {
+    let directions = &bins.directions;
     let mut remaining = flux.to_vec();
     let mut lobes = Vec::new();
     for _ in 0..count {
@@ -117,13 +132,23 @@ fn greedy_lobes(flux: &[f64], directions: &[DVec3], cones: &[Vec<u32>], count: u
             .map(|(c, cone)| (c, cone.iter().map(|&o| remaining[o as usize]).sum::<f64>()))
             .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)));
         let Some((centre, share)) = best.filter(|b| b.1 > 1e-9) else { break };
-        let mean: DVec3 = cones[centre].iter().map(|&o| directions[o as usize] * remaining[o as usize]).sum();
+        let mean = cones[centre].iter().map(|&o| directions[o as usize] * remaining[o as usize]).sum::<DVec3>().normalize();
+        let mut squared = 0.0;
         for &o in &cones[centre] {
+            let angle = directions[o as usize].angle_between(mean);
+            squared += remaining[o as usize] * (angle * angle + bins.solid_angles[o as usize] / std::f64::consts::TAU);
             remaining[o as usize] = 0.0;
         }
-        lobes.push(Lobe { direction: mean.normalize(), share, width });
+        let spread = (2.0 * std::f64::consts::SQRT_2 * (squared / share).sqrt()).to_degrees();
+        lobes.push(Lobe { direction: mean, share, width: spread.min(width) });
     }
     (lobes, remaining.iter().sum())
+}
+
+/// Outgoing bins: their directions (into the room) and solid angles (sr).
+struct Bins {
+    directions: Vec<DVec3>,
+    solid_angles: Vec<f64>,
 }
 
 /// A file's data as the fit reads it: per measured incoming direction,
@@ -132,8 +157,8 @@ fn greedy_lobes(flux: &[f64], directions: &[DVec3], cones: &[Vec<u32>], count: u
 struct Measured {
     /// The way the light travels, panel frame.
     incoming: Vec<DVec3>,
-    /// The outgoing bins' directions, into the room.
-    bins: Vec<DVec3>,
+    /// The outgoing bins.
+    bins: Bins,
     /// Share of the incoming flux into each bin, `[incoming][bin]`.
     flux: Vec<Vec<f64>>,
     /// Share of the incoming flux reflected back outside.
@@ -154,7 +179,7 @@ const TREE_SAMPLES: usize = 2;
 impl Measured {
     fn of(file: &BsdfFile) -> Self {
         match &file.scattering {
-            Scattering::Klems { basis, transmission, reflection } => {
+            Scattering::Klems { basis, transmission, reflection, .. } => {
                 let patches = klems_patches(basis);
                 let directions: Vec<DVec3> = patches.iter().map(|p| p.0).collect();
                 let hemisphere = |i: usize, get: &dyn Fn(usize, usize) -> f64| {
@@ -166,10 +191,10 @@ impl Measured {
                         .map(|i| reflection.as_ref().map_or(0.0, |r| hemisphere(i, &|i, o| r.get(i, o)).iter().sum()))
                         .collect(),
                     incoming: directions.clone(),
-                    bins: directions,
+                    bins: Bins { directions, solid_angles: klems_solid_angles(basis) },
                 }
             }
-            Scattering::TensorTree { transmission, reciprocal, reflection } => {
+            Scattering::TensorTree { transmission, reciprocal, reflection, .. } => {
                 Self::of_trees(transmission, *reciprocal, reflection.as_ref())
             }
         }
@@ -192,7 +217,7 @@ impl Measured {
             })
             .collect();
         let hemisphere = |[x, y]: [f64; 2], z_sign: f64| DVec3::new(x, y, z_sign * (1.0 - x * x - y * y).max(0.0).sqrt());
-        let bins = (0..TREE_BINS * TREE_BINS)
+        let directions: Vec<DVec3> = (0..TREE_BINS * TREE_BINS)
             .map(|b| {
                 hemisphere(
                     square_to_disk(((b / TREE_BINS) as f64 + 0.5) / TREE_BINS as f64, ((b % TREE_BINS) as f64 + 0.5) / TREE_BINS as f64),
@@ -200,6 +225,9 @@ impl Measured {
                 )
             })
             .collect();
+        // Equal projected solid angles: π / N² ÷ cos θ each (the rim's kept finite).
+        let solid_angles = directions.iter().map(|d| std::f64::consts::PI / (TREE_BINS * TREE_BINS) as f64 / d.z.max(0.05)).collect();
+        let bins = Bins { directions, solid_angles };
         // Each sample stands for π / side² of projected solid angle.
         let weight = std::f64::consts::PI / (side * side) as f64;
         // A coarse tree is read at 8 leaves per axis at least: a uniform one
@@ -222,6 +250,37 @@ impl Measured {
         }
         Self { incoming, bins, flux, reflected }
     }
+}
+
+/// Samples per axis of each hemisphere's square for a tree's back
+/// reflectance (32⁴ leaf lookups).
+const BACK_SAMPLES: usize = 32;
+
+/// The share of diffuse light from the room that a file's "Reflection
+/// Back" returns to it: (1/π) ∫∫ f cos θᵢ cos θₒ dωᵢ dωₒ over the room's
+/// hemisphere twice; 0 without that data.
+fn back_reflectance(file: &BsdfFile) -> f64 {
+    let rho = match &file.scattering {
+        Scattering::Klems { basis, back_reflection: Some(matrix), .. } => {
+            let patches = klems_patches(basis);
+            let n = patches.len();
+            (0..n).map(|i| patches[i].1 * (0..n).map(|o| matrix.get(i, o) * patches[o].1).sum::<f64>()).sum::<f64>() / std::f64::consts::PI
+        }
+        Scattering::TensorTree { back_reflection: Some(tree), .. } => {
+            // Each sample of a square stands for π / K² of projected solid angle.
+            let k = BACK_SAMPLES;
+            let directions: Vec<DVec3> = (0..k * k)
+                .map(|s| {
+                    let [x, y] = square_to_disk(((s / k) as f64 + 0.5) / k as f64, ((s % k) as f64 + 0.5) / k as f64);
+                    DVec3::new(x, y, (1.0 - x * x - y * y).max(0.0).sqrt())
+                })
+                .collect();
+            let sum: f64 = directions.iter().map(|&i| directions.iter().map(|&o| tree.value(i, o)).sum::<f64>()).sum();
+            std::f64::consts::PI * sum / (k * k * k * k) as f64
+        }
+        _ => 0.0,
+    };
+    rho.clamp(0.0, 1.0)
 }
 
 /// The directions (the way light travels) at the middles of a tree's
@@ -261,6 +320,8 @@ pub struct BsdfModel {
     pub captured: f64,
     /// The file it was read from (for `export-radiance`).
     file: Option<PathBuf>,
+    /// The share of the room's diffuse light it reflects back ("Reflection Back").
+    pub back_reflectance: f64,
 }
 
 impl std::fmt::Debug for BsdfModel {
@@ -273,7 +334,7 @@ impl BsdfModel {
     /// Fits `count` lobes of full angle `width` degrees at each measured direction.
     pub fn fit(file: &BsdfFile, count: usize, width: f64) -> Self {
         let measured = Measured::of(file);
-        let cones = cones(&measured.bins, width);
+        let cones = cones(&measured.bins.directions, width);
         let (mut captured, mut transmitted) = (0.0, 0.0);
         let fitted: Vec<Fitted> = measured
             .flux
@@ -300,7 +361,7 @@ impl BsdfModel {
             }
         }
         let captured = if transmitted > 0.0 { captured / transmitted } else { 1.0 };
-        Self { fitted, triangulation, vertex_patch, captured, file: None }
+        Self { fitted, triangulation, vertex_patch, captured, file: None, back_reflectance: back_reflectance(file) }
     }
 
     /// The fitted response at measured direction `patch`.
@@ -350,6 +411,10 @@ impl PanelModel for BsdfModel {
 
     fn bsdf_file(&self) -> Option<&Path> {
         self.file.as_deref()
+    }
+
+    fn back_reflectance(&self) -> f64 {
+        self.back_reflectance
     }
 }
 
@@ -590,6 +655,40 @@ mod tests {
                 assert!((r.transmitted() - 0.1 * std::f64::consts::PI).abs() < 1e-6, "{structure} {d}: {}", r.transmitted());
             }
         }
+    }
+
+    /// A lobe is as wide as the light it stands for: clear glass puts all of
+    /// it in the normal Klems patch (a cap of 5°: as wide as an even cone
+    /// of 2√2·√(1 − cos 5°) rad, 10.0°); the redirecting tree's lobe is a
+    /// Gaussian of 8.1° RMS (even-cone width 22.9°) seen through 16 leaves
+    /// per axis and cut by the 23° cone.
+    #[test]
+    fn lobes_are_as_wide_as_the_light_they_stand_for() {
+        let clear = BsdfModel::fit(&load("clear.xml"), 3, 23.0).response(DVec3::Z);
+        let cap = 2.0 * std::f64::consts::SQRT_2 * (1.0 - 5f64.to_radians().cos()).sqrt();
+        assert!((clear.lobes[0].width - cap.to_degrees()).abs() < 0.01, "{:?}", clear.lobes[0]);
+        let tree = BsdfModel::fit(&load("redirect_tt4.xml"), 3, 23.0);
+        for travel in [DVec3::Z, leaf_middle(DVec3::new(0.0, -0.5, 0.866), 4, 16.0)] {
+            let width = tree.response(travel).lobes[0].width;
+            println!("redirect_tt4.xml {travel}: main lobe {width:.1}° wide");
+            assert!((15.0..=23.0).contains(&width), "{travel}: {width}");
+        }
+    }
+
+    /// The share of the room's light a panel returns: figures computed
+    /// apart from this code (Python over the files' visible "Reflection
+    /// Back" matrices: ven45 0.35658, blinds 0.15757).
+    #[test]
+    fn back_reflectance_is_the_hemispherical_mean_of_reflection_back() {
+        let of = |file: &BsdfFile| BsdfModel::fit(file, 3, 23.0).back_reflectance;
+        assert!((of(&load("ven45.xml")) - 0.35658).abs() < 1e-4, "{}", of(&load("ven45.xml")));
+        assert!((of(&load("blinds.xml")) - 0.15757).abs() < 1e-4, "{}", of(&load("blinds.xml")));
+        // A one-leaf tree of 0.1/sr reflects π × 0.1 back.
+        let back = "<WavelengthDataBlock><WavelengthDataDirection>Reflection Back</WavelengthDataDirection><AngleBasis>LBNL/Shirley-Chiu</AngleBasis><ScatteringData>{ 0.1 }</ScatteringData></WavelengthDataBlock></WavelengthData>";
+        let text = tree_file("TensorTree3", "{ 0.2 }").replace("</WavelengthData>", back);
+        assert!((of(&xml::parse(&text, Path::new("back.xml")).unwrap()) - 0.1 * std::f64::consts::PI).abs() < 1e-6);
+        // Without "Reflection Back" nothing returns.
+        assert_eq!(of(&load("redirect_tt4.xml")), 0.0);
     }
 
     #[test]

@@ -54,16 +54,18 @@ pub struct BsdfFile {
     pub wavelength: String,
 }
 
-/// The scattering data of a file, as its kind keeps it.
+/// The scattering data of a file, as its kind keeps it: transmission and
+/// reflection of light from outside, and the reflection of light from the
+/// room ("Reflection Back").
 #[derive(Debug, Clone)]
 pub enum Scattering {
     /// Matrices over a Klems basis.
-    Klems { basis: Basis, transmission: Matrix, reflection: Option<Matrix> },
+    Klems { basis: Basis, transmission: Matrix, reflection: Option<Matrix>, back_reflection: Option<Matrix> },
     /// Tensor trees (Radiance's frame: +z into the room). `transmission`
     /// is "Transmission Front" (light from outside), or, when only the
     /// back one is given, "Transmission Back" read by reciprocity
     /// (`reciprocal`: query it with the two directions exchanged).
-    TensorTree { transmission: TensorTree, reciprocal: bool, reflection: Option<TensorTree> },
+    TensorTree { transmission: TensorTree, reciprocal: bool, reflection: Option<TensorTree>, back_reflection: Option<TensorTree> },
 }
 
 /// Klems bases have 145 patches at most (the full basis); this leaves room
@@ -258,7 +260,8 @@ fn klems(r: &Reader, rows_incident: bool) -> Result<BsdfFile, String> {
             Matrix { incoming: n, values }
         }
     };
-    let scattering = Scattering::Klems { basis, transmission, reflection: find("Reflection Front") };
+    let scattering =
+        Scattering::Klems { basis, transmission, reflection: find("Reflection Front"), back_reflection: find("Reflection Back") };
     Ok(BsdfFile { scattering, wavelength: wavelength.to_string() })
 }
 
@@ -288,12 +291,14 @@ fn tensor_trees(r: &Reader, dims: usize) -> Result<BsdfFile, String> {
         found.map(|k| blocks.swap_remove(k).2)
     };
     let reflection = find("Reflection Front");
+    let back_reflection = find("Reflection Back");
     let (transmission, reciprocal) = match (find("Transmission Front"), find("Transmission Back")) {
         (Some(front), _) => (front, false),
         (None, Some(back)) => (back, true),
         (None, None) => return Err(format!("{}: no transmission tree ({wavelength})", r.file.display())),
     };
-    Ok(BsdfFile { scattering: Scattering::TensorTree { transmission, reciprocal, reflection }, wavelength: wavelength.to_string() })
+    let scattering = Scattering::TensorTree { transmission, reciprocal, reflection, back_reflection };
+    Ok(BsdfFile { scattering, wavelength: wavelength.to_string() })
 }
 
 /// "Visible" when a file has visible data, else "Solar".
