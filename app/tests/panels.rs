@@ -209,6 +209,56 @@ fn a_panel_reflects_the_rooms_light_back_as_a_wall_would() {
     assert!(dark[3] < 0.8 * wall[3], "{dark:?} vs {wall:?}");
 }
 
+/// A panel sees the sky its window sees. Under an overhang a redirecting
+/// tree, which sends the upper sky's light to the ceiling, sends less of it
+/// when the overhang hides that sky; and a clear panel (one straight lobe,
+/// all of the light) lets in less sky than without the overhang, though
+/// more than an opening in its place at these floor sensors: a panel takes
+/// its windows' mean view of each sky bin (as Radiance's 3-phase daylight
+/// matrix does), an opening each ray's own, and the floor sensors look
+/// through the window's lower part, which sees under the overhang.
+#[test]
+fn an_overhang_hides_the_sky_from_a_panel_as_from_an_opening() {
+    use std::sync::Arc;
+    let catalog = all_panels();
+    // Direct sky at the floor sensors, then at four ceiling sensors above them.
+    let direct_sky = |name: &str, window: Option<&str>, overhang: bool| -> Vec<f64> {
+        let path = room_with(name, window, overhang);
+        let mut text = std::fs::read_to_string(&path).unwrap();
+        for (k, y) in [2.5, 3.0, 3.5, 4.0].iter().enumerate() {
+            text.push_str(&format!("\n[[sensors]]\nname = \"ceiling-{k}\"\nposition = [2.0, {y}, 3.0]\nnormal = [0.0, 0.0, -1.0]\n"));
+        }
+        std::fs::write(&path, text).unwrap();
+        let scene = Arc::new(load_scene(&path, &catalog).unwrap().scene);
+        // Many sensor rays: a sensor sees a little sky through a small window.
+        let settings = heliodon::light::LightSettings { rays_per_sensor: 16384, ..quick() };
+        let model = heliodon::light::LightModel::precompute(scene.clone(), settings).unwrap();
+        let sky = heliodon::sky::Sky::new(&heliodon::sky::SkySpec::Overcast, 30.0, 180.0, 0.2, 355).unwrap();
+        model.solve(&sky, None).sensors.iter().map(|s| s.direct_sky).collect()
+    };
+    let clear = Some("panel = \"grey_filter\"\ntransmittance = 1.0\n");
+    let (open, panel) = (direct_sky("overhang_open", None, true), direct_sky("overhang_clear", clear, true));
+    let unshaded = direct_sky("no_overhang_open", None, false);
+    let tree = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/bsdf/redirect_tt4.xml");
+    let tree = format!("panel = \"bsdf\"\nfile = \"{}\"\n", tree.display());
+    let (redirected, redirected_shaded) = (direct_sky("tree_open_sky", Some(&tree), false), direct_sky("tree_overhang", Some(&tree), true));
+    for k in 0..4 {
+        println!(
+            "floor {k}: opening {:.1} under the overhang, clear panel {:.1} under it, opening {:.1} without; ceiling {k}: tree {:.1}, under the overhang {:.1}",
+            open[k],
+            panel[k],
+            unshaded[k],
+            redirected[4 + k],
+            redirected_shaded[4 + k]
+        );
+    }
+    for k in 0..4 {
+        assert!(open[k] < 0.9 * unshaded[k], "the overhang hides sky: {open:?} vs {unshaded:?}");
+        assert!(panel[k] < 0.9 * unshaded[k] && panel[k] > open[k], "the panel sees the overhang: {panel:?} vs {open:?}, {unshaded:?}");
+        assert!(redirected_shaded[4 + k] < 0.9 * redirected[4 + k], "{redirected_shaded:?} vs {redirected:?}");
+    }
+}
+
 /// All the sun a prismatic window lets in lands inside the closed room:
 /// the direct sun on every patch side, times its area, adds up to the flux
 /// on the window times the panel's transmitted share.

@@ -125,7 +125,10 @@ impl LightModel {
         self.sky_bins.integrate_sphere_into(sky, &mut bins);
         let sun = sky.sun_up();
         let panels = self.panel_groups.iter().map(|g| g.radiance_through(&self.sky_bins, &bins)).collect();
-        let panel_sun = self.panel_groups.iter().map(|g| g.sun_diffuse_radiance(sun.as_ref())).collect();
+        // What shades a panel's windows from the sun shades what it diffuses.
+        let panel_sun = (self.panel_groups.iter().enumerate())
+            .map(|(k, g)| g.sun_diffuse_radiance(sun.as_ref()) * sun.as_ref().map_or(0.0, |s| self.panel_sunlit(k, s.direction)))
+            .collect();
         KeyRadiance { bin_count: self.bin_count(), bins, panels, panel_sun, window_panel: self.window_panels() }
     }
 }

@@ -199,13 +199,19 @@ impl LightModel {
                 match self.surface_of_patch(hit.patch) {
                     Surface::Diffuse(_) => hits.push(SideHit { side: side_of(hit.patch, cos > 0.0), weight, point }),
                     Surface::Panel(group) if depth < MAX_GLASS_DEPTH => {
-                        // From the room the ray meets the panel's room side too
-                        // (what it reflects back), and passes on.
                         let side = side_of(hit.patch, cos > 0.0);
                         if self.panel_room_side(hit.patch, group) == Some(side) {
+                            // From the room the ray meets the panel's room side
+                            // (what it reflects back) and the panel's light along
+                            // the ray, made at relight from the sky its windows
+                            // see; what lies beyond is not seen through a panel.
                             hits.push(SideHit { side, weight, point });
+                            let window = self.window_of_surface[self.scene.patches.patches[hit.patch as usize].surface as usize];
+                            let key = SkyKey { window, bin: self.sky_bins.sphere_bin(dir) as u32 };
+                            coefficients.push((key.pack(self.bin_count()), weight));
+                        } else {
+                            self.follow(point + dir * SURFACE_OFFSET, dir, weight, depth + 1, crossed, coefficients, hits)
                         }
-                        self.follow(point + dir * SURFACE_OFFSET, dir, weight, depth + 1, crossed, coefficients, hits)
                     }
                     Surface::Glass(glass) if depth < MAX_GLASS_DEPTH => {
                         let (t, r) = glass.at(cos);

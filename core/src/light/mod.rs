@@ -71,11 +71,12 @@ const MIN_WEIGHT: f64 = 1e-4;
 enum Surface {
     Diffuse([f64; 3]),
     Glass(Glass),
-    /// A panel window of this group: rays pass on (what they see beyond is
-    /// turned into the panel's light at relight time, see
-    /// `PanelGroup::radiance_through`); the sun passes only along its lobes.
-    /// Its room side also reflects the room's light back (its group's
-    /// `back_reflectance`): a ray from the room meets that side and passes.
+    /// A panel window of this group: a ray from the room ends there, keyed
+    /// by its window and direction (the panel's light along it is made at
+    /// relight from the sky the windows see, `PanelGroup::radiance_through`),
+    /// and meets the room side, which reflects the room's light back (its
+    /// group's `back_reflectance`); a ray from outside passes on. The sun
+    /// passes only along its lobes.
     Panel(u32),
 }
 
@@ -238,7 +239,7 @@ impl LightModel {
         for (k, window) in scene.windows.iter().enumerate() {
             window_of_surface[window.surface as usize] = Some(k as u32);
         }
-        Self {
+        let mut model = Self {
             sky_bins: SkyPatches::reinhart(settings.sky_subdivision),
             windows,
             window_of_surface,
@@ -252,7 +253,9 @@ impl LightModel {
             surfaces,
             side_gathers: Vec::new(),
             sensors: Vec::new(),
-        }
+        };
+        model.look_out_of_panels();
+        model
     }
 
     fn surface_of_patch(&self, patch: u32) -> Surface {

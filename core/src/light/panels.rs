@@ -9,7 +9,10 @@ use std::sync::{Arc, OnceLock};
 
 use glam::DVec3;
 
+use super::gather::sample_area;
+use super::sampling::Rng;
 use super::windows::WindowGroups;
+use super::{LightModel, SURFACE_OFFSET};
 use crate::panel::{Lobe, PanelModel};
 use crate::scene::{MaterialKind, Scene};
 use crate::sky::{SkyPatches, SunSource};
@@ -57,8 +60,84 @@ pub struct PanelGroup {
     /// The model's [`PanelModel::back_reflectance`], clamped to 0-1: the
     /// windows' room side is a diffuse reflector of it.
     pub back_reflectance: f64,
+    /// What the windows see outside ([`Outlook`]); everything until
+    /// [`LightModel`] looks.
+    pub outlook: Outlook,
     /// How sky and ground light pass it, made on first use.
     transfer: OnceLock<SkyTransfer>,
+}
+
+/// What a panel group's windows see outside: overhangs, fins and
+/// neighbouring buildings hide part of the sky from them, and shade them
+/// from the sun, as they do a plain window.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Outlook {
+    /// Seeded points on the windows, just outside them.
+    pub points: Vec<DVec3>,
+    /// Per sphere bin: the share of the points that see it (through any
+    /// glass on the way, by its transmittance); ground bins count as seen
+    /// (their light is the ground's, wherever it comes from). Empty: all
+    /// seen.
+    pub sky_seen: Vec<f64>,
+}
+
+/// Points per window an outlook is taken from.
+const OUTLOOK_POINTS: usize = 16;
+
+impl LightModel {
+    /// Every panel group's [`Outlook`], by shadow rays from points on its
+    /// windows toward each sky bin's middle.
+    pub(super) fn look_out_of_panels(&mut self) {
+        let bins = self.sky_bins.len();
+        let outlooks: Vec<Outlook> = (0..self.panel_groups.len())
+            .map(|g| {
+                let outward = -self.panel_groups[g].frame.z;
+                let mut rng = Rng::new(4, g as u64);
+                let points: Vec<DVec3> = self
+                    .scene
+                    .windows
+                    .iter()
+                    .filter(|w| self.group_of_surface[w.surface as usize] == Some(g as u32))
+                    .flat_map(|w| {
+                        let surface = &self.scene.surfaces[w.surface as usize];
+                        let mut total = 0.0;
+                        let triangles: Vec<([DVec3; 3], f64)> = self.scene.triangles
+                            [surface.triangles.start as usize..surface.triangles.end as usize]
+                            .iter()
+                            .map(|t| {
+                                let t = t.vertices.map(|v| v.as_dvec3());
+                                total += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+                                (t, total)
+                            })
+                            .collect();
+                        (0..OUTLOOK_POINTS).map(|_| sample_area(&triangles, &mut rng) + outward * SURFACE_OFFSET).collect::<Vec<_>>()
+                    })
+                    .collect();
+                let sky_seen = (0..2 * bins)
+                    .map(|b| {
+                        let direction = self.sky_bins.patches[b % bins].direction;
+                        if b >= bins || direction.dot(outward) <= 0.0 || points.is_empty() {
+                            return 1.0;
+                        }
+                        points.iter().map(|&p| self.sun_transmittance(p, direction)).sum::<f64>() / points.len() as f64
+                    })
+                    .collect();
+                Outlook { points, sky_seen }
+            })
+            .collect();
+        for (group, outlook) in self.panel_groups.iter_mut().zip(outlooks) {
+            group.outlook = outlook;
+        }
+    }
+
+    /// The share of panel group `group`'s windows the sun reaches.
+    pub(super) fn panel_sunlit(&self, group: usize, sun: DVec3) -> f64 {
+        let points = &self.panel_groups[group].outlook.points;
+        if points.is_empty() {
+            return 1.0;
+        }
+        points.iter().map(|&p| self.sun_transmittance(p, sun)).sum::<f64>() / points.len() as f64
+    }
 }
 
 /// How a panel group passes sky and ground light, per sphere bin the light
@@ -66,7 +145,6 @@ pub struct PanelGroup {
 /// incoming bin's radiance to the radiance seen through the panel in the
 /// outgoing bin (share · cos θin · ωin / (cos θout · ωout)), and the factor
 /// to the radiance of its diffuse transmission (τd · cos θin · ωin / π).
-/// The panel is taken to see the sky and ground unobstructed.
 pub struct SkyTransfer {
     /// Per incoming bin: (outgoing bin, radiance factor) for each transmitted lobe.
     pub lobes: Vec<Vec<(u32, f64)>>,
@@ -119,12 +197,14 @@ impl PanelGroup {
     }
 
     /// Radiance (W/sr/m²) of sky and ground light seen through the group's
-    /// windows in every sphere bin, for bin radiances `sky`.
+    /// windows in every sphere bin, for bin radiances `sky` (each as much as
+    /// the windows see of it: [`Outlook`]).
     pub fn radiance_through(&self, bins: &SkyPatches, sky: &[f64]) -> Vec<f64> {
         let transfer = self.sky_transfer(bins);
         let mut out = vec![0.0; sky.len()];
         let mut diffuse = 0.0;
         for (b, &radiance) in sky.iter().enumerate() {
+            let radiance = radiance * self.outlook.sky_seen.get(b).copied().unwrap_or(1.0);
             if radiance <= 0.0 {
                 continue;
             }
@@ -178,6 +258,7 @@ pub fn panel_groups(scene: &Scene, windows: &WindowGroups) -> (Vec<PanelGroup>, 
             model: model.0.clone(),
             frame,
             back_reflectance,
+            outlook: Outlook::default(),
             transfer: OnceLock::new(),
         });
     }

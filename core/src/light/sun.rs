@@ -60,7 +60,7 @@ impl LightModel {
     /// How much of the sun reaches `point` (through glass; 0 when blocked).
     /// The product of the glass crossed does not depend on their order, so
     /// one traversal visits them all and stops at the first opaque surface.
-    fn sun_transmittance(&self, point: DVec3, sun: DVec3) -> f64 {
+    pub(super) fn sun_transmittance(&self, point: DVec3, sun: DVec3) -> f64 {
         let mut transmittance = 1.0;
         // Glass surfaces crossed, by distance: a ray through the edge between
         // two triangles of one surface meets it twice.
