@@ -6,6 +6,11 @@
 //! reflected specularly (and traced on), a share diffusely and the rest
 //! absorbed. Specular paths end in lobes: the direct pass and even bounces
 //! keep the incoming direction, odd bounces leave mirrored about the slats.
+//! Light from the room meets the slats as light from outside meets slats
+//! tilted the other way (the window's plane mirrors the profile), and under
+//! light from the whole hemisphere those return what the slats themselves
+//! do (mirroring up and down turns the tilt over too): the back reflectance
+//! is the share of diffuse light from outside the slats send back.
 //!
 //! Scene-file keys (`kind = "panel"`, `panel = "venetian"`): `slat_width`
 //! and `slat_spacing` (m), `tilt` (degrees, −89 to 89; positive turns a
@@ -38,7 +43,7 @@ impl PanelType for Venetian {
         if specular + diffuse > 1.0 {
             return Err(ParameterError::new(DIFFUSE.name, format!("specular + diffuse = {} is more than 1", specular + diffuse)));
         }
-        Ok(Arc::new(VenetianModel { width, spacing, tilt: tilt.to_radians(), specular, diffuse }))
+        Ok(Arc::new(VenetianModel::new(width, spacing, tilt.to_radians(), specular, diffuse)))
     }
 }
 
@@ -64,9 +69,36 @@ pub struct VenetianModel {
     tilt: f64,
     specular: f64,
     diffuse: f64,
+    /// Share of the room's diffuse light sent back into it.
+    back_reflectance: f64,
 }
 
+/// Directions per axis of the hemisphere the back reflectance is averaged over.
+const HEMISPHERE_STEPS: usize = 24;
+
 impl VenetianModel {
+    fn new(width: f64, spacing: f64, tilt: f64, specular: f64, diffuse: f64) -> Self {
+        let mut model = Self { width, spacing, tilt, specular, diffuse, back_reflectance: 0.0 };
+        model.back_reflectance = model.hemispherical_reflectance();
+        model
+    }
+
+    /// What the slats send back out of light arriving evenly (diffusely)
+    /// from outside: the mean reflected share over directions of equal
+    /// projected solid angle (sin²θ and φ in even steps).
+    fn hemispherical_reflectance(&self) -> f64 {
+        let n = HEMISPHERE_STEPS;
+        let total: f64 = (0..n * 2 * n)
+            .map(|k| {
+                let (sin, phi) =
+                    ((((k / (2 * n)) as f64 + 0.5) / n as f64).sqrt(), std::f64::consts::PI * ((k % (2 * n)) as f64 + 0.5) / n as f64);
+                let r = self.response(DVec3::new(sin * phi.cos(), sin * phi.sin(), (1.0 - sin * sin).sqrt()));
+                r.diffuse_reflectance + r.lobes.iter().filter(|l| l.direction.z < 0.0).map(|l| l.share).sum::<f64>()
+            })
+            .sum();
+        total / (2 * n * n) as f64
+    }
+
     /// Unit vector along a slat from its outer to its inner edge, and the
     /// slat's normal, in the profile plane (y up, z into the room).
     fn slat_axes(&self) -> (DVec3, DVec3) {
@@ -167,6 +199,10 @@ impl PanelModel for VenetianModel {
         response.lobes.sort_by(|a, b| b.share.total_cmp(&a.share));
         response
     }
+
+    fn back_reflectance(&self) -> f64 {
+        self.back_reflectance
+    }
 }
 
 #[cfg(test)]
@@ -174,11 +210,26 @@ mod tests {
     use super::*;
 
     fn model(width: f64, spacing: f64, tilt: f64, specular: f64, diffuse: f64) -> VenetianModel {
-        VenetianModel { width, spacing, tilt: f64::to_radians(tilt), specular, diffuse }
+        VenetianModel::new(width, spacing, f64::to_radians(tilt), specular, diffuse)
     }
 
     fn from_above(altitude: f64) -> DVec3 {
         DVec3::new(0.0, -altitude.to_radians().sin(), altitude.to_radians().cos())
+    }
+
+    /// Slats return the room's light as their geometry says: closed
+    /// mirror slats send most of it back (over half; interreflection between
+    /// the overlapping slats absorbs some); thin open slats little; and
+    /// slats tilted either way alike (the geometry's mirror in y).
+    #[test]
+    fn slats_return_the_rooms_light_as_their_geometry_says() {
+        let closed = model(0.025, 0.0225, 80.0, 0.9, 0.05);
+        assert!(closed.back_reflectance > 0.5, "{}", closed.back_reflectance);
+        let open = model(0.002, 0.05, 0.0, 0.9, 0.05);
+        assert!(open.back_reflectance < 0.05, "{}", open.back_reflectance);
+        let (up, down) = (model(0.025, 0.0225, 30.0, 0.9, 0.05), model(0.025, 0.0225, -30.0, 0.9, 0.05));
+        assert!((up.back_reflectance - down.back_reflectance).abs() < 1e-3, "{} vs {}", up.back_reflectance, down.back_reflectance);
+        assert!(up.back_reflectance > open.back_reflectance && up.back_reflectance < closed.back_reflectance);
     }
 
     #[test]
