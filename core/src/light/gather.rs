@@ -260,15 +260,7 @@ impl LightModel {
     /// A patch's render triangles with their cumulative areas.
     pub(super) fn patch_triangles(&self, patch: usize) -> Vec<([DVec3; 3], f64)> {
         let range = self.scene.patches.patches[patch].triangles.clone();
-        let mut total = 0.0;
-        self.scene.patches.triangles[range.start as usize..range.end as usize]
-            .iter()
-            .map(|t| {
-                let t = t.map(|v| v.as_dvec3());
-                total += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
-                (t, total)
-            })
-            .collect()
+        with_cumulative_areas(self.scene.patches.triangles[range.start as usize..range.end as usize].iter().copied())
     }
 
     /// A sensor's gather, its sun points and where its rays land.
@@ -326,6 +318,18 @@ fn place_sensor(tracer: &Tracer, sensor: &Sensor, n: usize) -> Vec<DVec3> {
 pub fn sensor_points(scene: &Scene) -> Vec<Vec<DVec3>> {
     let tracer = Tracer::new(&scene.patches);
     scene.sensors.iter().map(|s| place_sensor(&tracer, s, 4)).collect()
+}
+
+/// Triangles with the running total of their areas, for [`sample_area`].
+pub(super) fn with_cumulative_areas(triangles: impl Iterator<Item = [glam::Vec3; 3]>) -> Vec<([DVec3; 3], f64)> {
+    let mut total = 0.0;
+    triangles
+        .map(|t| {
+            let t = t.map(|v| v.as_dvec3());
+            total += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+            (t, total)
+        })
+        .collect()
 }
 
 /// A uniformly distributed point on triangles given with cumulative areas.

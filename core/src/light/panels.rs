@@ -9,7 +9,7 @@ use std::sync::{Arc, OnceLock};
 
 use glam::DVec3;
 
-use super::gather::sample_area;
+use super::gather::{sample_area, with_cumulative_areas};
 use super::sampling::Rng;
 use super::windows::WindowGroups;
 use super::{LightModel, SURFACE_OFFSET};
@@ -99,17 +99,10 @@ impl LightModel {
                     .iter()
                     .filter(|w| self.group_of_surface[w.surface as usize] == Some(g as u32))
                     .flat_map(|w| {
-                        let surface = &self.scene.surfaces[w.surface as usize];
-                        let mut total = 0.0;
-                        let triangles: Vec<([DVec3; 3], f64)> = self.scene.triangles
-                            [surface.triangles.start as usize..surface.triangles.end as usize]
-                            .iter()
-                            .map(|t| {
-                                let t = t.vertices.map(|v| v.as_dvec3());
-                                total += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
-                                (t, total)
-                            })
-                            .collect();
+                        let range = self.scene.surfaces[w.surface as usize].triangles.clone();
+                        let triangles = with_cumulative_areas(
+                            self.scene.triangles[range.start as usize..range.end as usize].iter().map(|t| t.vertices),
+                        );
                         (0..OUTLOOK_POINTS).map(|_| sample_area(&triangles, &mut rng) + outward * SURFACE_OFFSET).collect::<Vec<_>>()
                     })
                     .collect();
