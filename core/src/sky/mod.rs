@@ -271,6 +271,9 @@ impl SkyDirection {
     }
 }
 
+/// Below this weight of the sky term, a direction sees the ground glow alone.
+const NEGLIGIBLE_SKY_WEIGHT: f64 = 1e-9;
+
 /// Weight of the sky term against the ground glow (skybright.cal):
 /// (Dz+1.01)^10 / ((Dz+1.01)^10 + (Dz+1.01)^−10).
 pub fn blend_weight(dz: f64) -> f64 {
@@ -366,6 +369,12 @@ impl Sky {
 
     /// [`Self::radiance`] for a direction whose own terms are computed already.
     pub fn radiance_toward(&self, d: &SkyDirection) -> f64 {
+        // Deep below the horizon the sky's weight (under 1e-9) would not
+        // show in any reading: the ground glow alone, without evaluating
+        // the sky (the annual study asks for every bin every hour).
+        if d.blend < NEGLIGIBLE_SKY_WEIGHT {
+            return self.ground_radiance;
+        }
         let sky = match &self.distribution {
             Distribution::Dark => return 0.0,
             Distribution::Gensky(g) => g.sky(d),

@@ -214,7 +214,13 @@ fn coefficients(zenith: f64, clearness: f64, brightness: f64) -> [f64; 5] {
 /// Relative luminance for a point at zenith angle `dzeta` and angle `gamma`
 /// from the sun (radians).
 fn relative_luminance(c: &[f64; 5], cos_dzeta: f64, gamma: f64) -> f64 {
-    (1.0 + c[0] * (c[1] / cos_dzeta).exp()) * (1.0 + c[2] * (c[3] * gamma).exp() + c[4] * gamma.cos().powi(2))
+    relative_luminance_cos(c, cos_dzeta, gamma, gamma.cos())
+}
+
+/// [`relative_luminance`] with cos γ known (a sky sample has it as its dot
+/// product with the sun, and it is evaluated for every bin every hour).
+fn relative_luminance_cos(c: &[f64; 5], cos_dzeta: f64, gamma: f64, cos_gamma: f64) -> f64 {
+    (1.0 + c[0] * (c[1] / cos_dzeta).exp()) * (1.0 + c[2] * (c[3] * gamma).exp() + c[4] * cos_gamma * cos_gamma)
 }
 
 /// gendaylit's normalisation integral: Σ lv·cos θ · 2π/145 over its 145
@@ -303,8 +309,8 @@ pub fn compute(input: Input, altitude: f64, azimuth: f64, day_of_year: f64, grou
 impl Perez {
     /// perezlum.cal's sky term (before the blend into the ground glow).
     pub fn sky(&self, d: DVec3) -> f64 {
-        let gamma = d.dot(self.sun).clamp(-1.0, 1.0).acos();
-        self.normalisation * relative_luminance(&self.coefficients, d.z.max(0.01), gamma)
+        let cos_gamma = d.dot(self.sun).clamp(-1.0, 1.0);
+        self.normalisation * relative_luminance_cos(&self.coefficients, d.z.max(0.01), cos_gamma.acos(), cos_gamma)
     }
 
     /// The sun direction the sky function uses (lowered to 87°).
