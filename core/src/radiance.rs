@@ -11,13 +11,13 @@
 //! [`PanelModel::bsdf_file`]: crate::panel::PanelModel::bsdf_file
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use crate::light::{LightModel, PanelFrame, sensor_points};
 use crate::report::csv_field;
 use crate::scene::{MaterialKind, Scene};
 use crate::sky::{Sky, radiance_sky};
-use std::sync::Arc;
 
 /// rtrace settings of the reference runs in ../shared/validation: pure Monte
 /// Carlo, 16 bounces, converged well under 1%.
@@ -68,7 +68,7 @@ struct BsdfGroup {
     material: u32,
     frame: PanelFrame,
     /// The data file, absolute.
-    file: std::path::PathBuf,
+    file: PathBuf,
 }
 
 impl BsdfWindows {

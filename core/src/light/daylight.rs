@@ -127,7 +127,10 @@ impl LightModel {
         let panels = self.panel_groups.iter().map(|g| g.radiance_through(&self.sky_bins, &bins)).collect();
         // What shades a panel's windows from the sun shades what it diffuses.
         let panel_sun = (self.panel_groups.iter().enumerate())
-            .map(|(k, g)| g.sun_diffuse_radiance(sun.as_ref()) * sun.as_ref().map_or(0.0, |s| self.panel_sunlit(k, s.direction)))
+            .map(|(k, g)| match (g.sun_diffuse_radiance(sun.as_ref()), &sun) {
+                (radiance, Some(s)) if radiance > 0.0 => radiance * self.panel_sunlit(k, s.direction),
+                _ => 0.0,
+            })
             .collect();
         KeyRadiance { bin_count: self.bin_count(), bins, panels, panel_sun, window_panel: self.window_panels() }
     }

@@ -109,10 +109,7 @@ impl LightModel {
                 let sky_seen = (0..2 * bins)
                     .map(|b| {
                         let direction = self.sky_bins.patches[b % bins].direction;
-                        if b >= bins || direction.dot(outward) <= 0.0 || points.is_empty() {
-                            return 1.0;
-                        }
-                        points.iter().map(|&p| self.sun_transmittance(p, direction)).sum::<f64>() / points.len() as f64
+                        if b >= bins || direction.dot(outward) <= 0.0 { 1.0 } else { self.share_seeing(&points, direction) }
                     })
                     .collect();
                 Outlook { points, sky_seen }
@@ -125,11 +122,16 @@ impl LightModel {
 
     /// The share of panel group `group`'s windows the sun reaches.
     pub(super) fn panel_sunlit(&self, group: usize, sun: DVec3) -> f64 {
-        let points = &self.panel_groups[group].outlook.points;
+        self.share_seeing(&self.panel_groups[group].outlook.points, sun)
+    }
+
+    /// The mean of what reaches `points` from `direction` (through glass,
+    /// by its transmittance); 1 without points.
+    fn share_seeing(&self, points: &[DVec3], direction: DVec3) -> f64 {
         if points.is_empty() {
             return 1.0;
         }
-        points.iter().map(|&p| self.sun_transmittance(p, sun)).sum::<f64>() / points.len() as f64
+        points.iter().map(|&p| self.sun_transmittance(p, direction)).sum::<f64>() / points.len() as f64
     }
 }
 

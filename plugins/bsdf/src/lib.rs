@@ -42,7 +42,7 @@ use heliodon_core::glam::DVec3;
 use heliodon_core::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters};
 use spade::{DelaunayTriangulation, FloatTriangulation, Point2, Triangulation};
 
-use tensor_tree::{TensorTree, square_to_disk};
+use tensor_tree::{TensorTree, cell_direction};
 use xml::{Basis, BsdfFile, Scattering};
 
 const FILE: Key = Key::file("file", "LBNL BSDF XML (Klems basis or tensor tree)", "xml");
@@ -208,23 +208,15 @@ impl Measured {
         // turn with the light, so every bin takes the most samples.
         let samples = if transmission.dims() == 4 { (finest / TREE_BINS).clamp(1, TREE_SAMPLES) } else { TREE_SAMPLES };
         let side = TREE_BINS * samples;
-        // Every sample point of the square on the disk, and its bin.
-        let points: Vec<([f64; 2], usize)> = (0..side * side)
+        // Every sample of the square, made once: its direction into the
+        // room, its mirror back outside, and its bin.
+        let points: Vec<(DVec3, DVec3, usize)> = (0..side * side)
             .map(|k| {
                 let (u, v) = (k / side, k % side);
-                let point = square_to_disk((u as f64 + 0.5) / side as f64, (v as f64 + 0.5) / side as f64);
-                (point, (u / samples) * TREE_BINS + v / samples)
+                (cell_direction(k, side, 1.0), cell_direction(k, side, -1.0), (u / samples) * TREE_BINS + v / samples)
             })
             .collect();
-        let hemisphere = |[x, y]: [f64; 2], z_sign: f64| DVec3::new(x, y, z_sign * (1.0 - x * x - y * y).max(0.0).sqrt());
-        let directions: Vec<DVec3> = (0..TREE_BINS * TREE_BINS)
-            .map(|b| {
-                hemisphere(
-                    square_to_disk(((b / TREE_BINS) as f64 + 0.5) / TREE_BINS as f64, ((b % TREE_BINS) as f64 + 0.5) / TREE_BINS as f64),
-                    1.0,
-                )
-            })
-            .collect();
+        let directions: Vec<DVec3> = (0..TREE_BINS * TREE_BINS).map(|b| cell_direction(b, TREE_BINS, 1.0)).collect();
         // Equal projected solid angles: π / N² ÷ cos θ each (the rim's kept finite).
         let solid_angles = directions.iter().map(|d| std::f64::consts::PI / (TREE_BINS * TREE_BINS) as f64 / d.z.max(0.05)).collect();
         let bins = Bins { directions, solid_angles };
@@ -238,15 +230,12 @@ impl Measured {
         for &travel in &incoming {
             // Radiance's vectors point away from the surface: toward the source is −travel.
             let mut bin_flux = vec![0.0; TREE_BINS * TREE_BINS];
-            for &(point, bin) in &points {
-                let out = hemisphere(point, 1.0);
+            for &(out, _, bin) in &points {
                 let bsdf = if reciprocal { transmission.value(out, -travel) } else { transmission.value(-travel, out) };
                 bin_flux[bin] += bsdf * weight;
             }
             flux.push(bin_flux);
-            reflected.push(
-                reflection.map_or(0.0, |r| points.iter().map(|&(point, _)| r.value(-travel, hemisphere(point, -1.0)) * weight).sum()),
-            );
+            reflected.push(reflection.map_or(0.0, |r| points.iter().map(|&(_, back, _)| r.value(-travel, back) * weight).sum()));
         }
         Self { incoming, bins, flux, reflected }
     }
@@ -269,12 +258,7 @@ fn back_reflectance(file: &BsdfFile) -> f64 {
         Scattering::TensorTree { back_reflection: Some(tree), .. } => {
             // Each sample of a square stands for π / K² of projected solid angle.
             let k = BACK_SAMPLES;
-            let directions: Vec<DVec3> = (0..k * k)
-                .map(|s| {
-                    let [x, y] = square_to_disk(((s / k) as f64 + 0.5) / k as f64, ((s % k) as f64 + 0.5) / k as f64);
-                    DVec3::new(x, y, (1.0 - x * x - y * y).max(0.0).sqrt())
-                })
-                .collect();
+            let directions: Vec<DVec3> = (0..k * k).map(|s| cell_direction(s, k, 1.0)).collect();
             let sum: f64 = directions.iter().map(|&i| directions.iter().map(|&o| tree.value(i, o)).sum::<f64>()).sum();
             std::f64::consts::PI * sum / (k * k * k * k) as f64
         }
@@ -293,7 +277,7 @@ fn tree_incoming(dims: usize, cells: usize) -> Vec<DVec3> {
     let on_hemisphere = |[x, y]: [f64; 2]| DVec3::new(x, y, (1.0 - x * x - y * y).max(0.0).sqrt());
     let middle = |k: usize| (k as f64 + 0.5) / cells as f64;
     if dims == 4 {
-        (0..cells * cells).map(|k| on_hemisphere(square_to_disk(middle(k / cells), middle(k % cells)))).collect()
+        (0..cells * cells).map(|k| cell_direction(k, cells, 1.0)).collect()
     } else {
         (0..cells / 2)
             .flat_map(|k| {
@@ -421,6 +405,7 @@ impl PanelModel for BsdfModel {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tensor_tree::square_to_disk;
     use std::path::{Path, PathBuf};
 
     fn sample(name: &str) -> PathBuf {
@@ -444,14 +429,7 @@ mod tests {
     /// a midpoint sum over 256² cells of equal projected solid angle.
     fn transmittance(f: impl Fn(DVec3, DVec3) -> f64, travel: DVec3) -> f64 {
         let n = 256;
-        (0..n * n)
-            .map(|k| {
-                let [x, y] = square_to_disk(((k / n) as f64 + 0.5) / n as f64, ((k % n) as f64 + 0.5) / n as f64);
-                f(-travel, DVec3::new(x, y, (1.0 - x * x - y * y).max(0.0).sqrt()))
-            })
-            .sum::<f64>()
-            * std::f64::consts::PI
-            / (n * n) as f64
+        (0..n * n).map(|k| f(-travel, cell_direction(k, n, 1.0))).sum::<f64>() * std::f64::consts::PI / (n * n) as f64
     }
 
     /// The middle of the incoming leaf holding `travel` in a tree whose

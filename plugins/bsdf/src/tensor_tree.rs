@@ -220,6 +220,15 @@ pub fn disk_to_square(x: f64, y: f64) -> [f64; 2] {
     [0.5 * (a + 1.0), 0.5 * (b + 1.0)]
 }
 
+/// The direction through the middle of cell `k` (row-major, the first
+/// axis slowest) of a `cells` × `cells` grid on the unit square, lifted
+/// from the disk onto the hemisphere on the side of `z_sign` (±1).
+pub fn cell_direction(k: usize, cells: usize, z_sign: f64) -> DVec3 {
+    let middle = |i: usize| (i as f64 + 0.5) / cells as f64;
+    let [x, y] = square_to_disk(middle(k / cells), middle(k % cells));
+    DVec3::new(x, y, z_sign * (1.0 - x * x - y * y).max(0.0).sqrt())
+}
+
 /// The inverse of [`disk_to_square`]: a point of the unit square on the disk.
 pub fn square_to_disk(u: f64, v: f64) -> [f64; 2] {
     use std::f64::consts::FRAC_PI_4;
