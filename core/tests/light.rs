@@ -580,7 +580,8 @@ fn the_sun_path_reads_what_tracing_reads() {
 /// whole: the warm year equals the one `annual` traces itself, hour by hour
 /// and bit for bit; a damaged file is traced again. Another site or another
 /// reflectance is another table (another key), and `annual` refuses a table
-/// that does not fit.
+/// that does not fit. The sensor coefficients kept beside it read back as
+/// solved, and another reflectance solves its own.
 #[test]
 fn the_years_sun_is_cached_and_a_warm_year_reads_what_a_traced_one_does() {
     use heliodon_core::annual::{AnnualOptions, SunHours, annual};
@@ -632,6 +633,13 @@ fn the_years_sun_is_cached_and_a_warm_year_reads_what_a_traced_one_does() {
     let read = annual(&model, &site, &weather, &options, &|_| {}).unwrap();
     assert_eq!(traced, read);
     assert!(read.sensors.iter().any(|s| s.ase_hours > 0) && read.sensors.iter().all(|s| s.da300 > 0.0), "{:?}", read.sensors);
+    // Through the cache folder the sensor coefficients are kept beside the
+    // table and read back as solved: twice, the traced year.
+    let through_cache = AnnualOptions { keep_hourly: true, sun_cache: Some(&dir), ..Default::default() };
+    for _ in 0..2 {
+        assert_eq!(annual(&model, &site, &weather, &through_cache, &|_| {}).unwrap(), traced);
+    }
+    assert!(matches!(model.sensor_coefficients_cached(&dir).1, CacheOutcome::Hit(_)));
 
     let moved = heliodon_core::site::Site { latitude: site.latitude + 5.0, ..site };
     assert!(matches!(cached(&model, &moved).1, CacheOutcome::Stored(_)), "another site, another table");
@@ -642,6 +650,10 @@ fn the_years_sun_is_cached_and_a_warm_year_reads_what_a_traced_one_does() {
     wall.kind = MaterialKind::Diffuse { reflectance: heliodon_core::scene::Rgb([0.123, 0.456, 0.789]) };
     let repainted = LightModel::precompute(Arc::new(repainted), LightSettings::default()).unwrap();
     assert_ne!(SunHours::key(&repainted, &site, false), SunHours::key(&model, &site, false), "reflectances are in the key");
+    let (own, outcome) = repainted.sensor_coefficients_cached(&dir);
+    assert!(matches!(outcome, CacheOutcome::Stored(_)), "another reflectance, other coefficients: {outcome:?}");
+    let sky = sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "12:00");
+    assert_eq!(own.readings(&repainted, &sky, None), repainted.sensor_coefficients().readings(&repainted, &sky, None));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -273,9 +273,9 @@ pub struct AnnualOptions<'a> {
     /// `sun_cache`). With shades
     /// studied it must keep the shade groups' sun.
     pub sun_hours: Option<&'a SunHours>,
-    /// Where the run keeps the year's sun it makes (the light cache
-    /// folder), so the next year of the same scene and site reads it;
-    /// `None`: traced for this run only.
+    /// Where the run keeps the year's sun and the sensor coefficients it
+    /// makes (the light cache folder), so the next year of the same scene
+    /// and site reads them; `None`: made for this run only.
     pub sun_cache: Option<&'a std::path::Path>,
 }
 
@@ -295,11 +295,16 @@ pub fn annual(
     let AnnualOptions { occupancy, shades, keep_hourly, .. } = *options;
     let scene = &model.scene;
     let sensor_count = scene.sensors.len();
+    // Through the light cache where the run has one.
+    let solve = |model: &LightModel| match options.sun_cache {
+        Some(dir) => model.sensor_coefficients_cached(dir).0,
+        None => model.sensor_coefficients(),
+    };
     let own;
     let coefficients = match options.coefficients {
         Some(coefficients) => coefficients,
         None => {
-            own = model.sensor_coefficients();
+            own = solve(model);
             &own
         }
     };
@@ -354,7 +359,7 @@ pub fn annual(
     let shaded: Vec<(u32, &LightModel, SensorCoefficients, SunPath)> = shaded_models
         .iter()
         .map(|(mask, model)| {
-            let coefficients = model.sensor_coefficients();
+            let coefficients = solve(model);
             let suns: Vec<DVec3> = (0..HOURS).filter(|&k| down[k] == *mask).filter_map(|k| lit(k)?.sun).map(|s| s.direction).collect();
             let path = SunPath::new(model, &coefficients, site, &suns, None);
             (*mask, model, coefficients, path)

@@ -32,8 +32,11 @@
 //! sides at once (in blocks, so memory stays bounded); the coefficients
 //! hold sensors × slots and sensors × patch sides numbers.
 
+use std::path::Path;
+
 use glam::DVec3;
 
+use super::cache::{self, CacheOutcome, Fnv, Reader, Writer};
 use super::daylight::RadianceSlots;
 use super::sun::Reach;
 use super::{LightModel, SensorReading, SunBeam, luminous, par_map};
@@ -42,6 +45,13 @@ use crate::sky::{LUMINOUS_EFFICACY, Sky, SunSource};
 
 /// Sensors whose adjoints are iterated together.
 const BLOCK: usize = 32;
+
+/// Bump when the coefficients or how they are stored change.
+const FORMAT: u32 = 1;
+
+/// The most coefficients kept in the light cache, bytes: past it (a grid of
+/// tens of thousands of sensors) they are solved each run instead.
+const MAX_CACHED_BYTES: usize = 256 << 20;
 
 /// Each sensor's interreflected light per unit of every source, for one
 /// model. They hold for the model they were made from and for any that
@@ -61,6 +71,9 @@ pub struct SensorCoefficients {
     /// Sides some sensor sees, directly or by interreflection: the sun
     /// elsewhere (on a roof, say) changes no reading and is not traced.
     seen: Vec<bool>,
+    /// Sides some sensor's rays land on: where the sun's first bounce is
+    /// traced, hour by hour.
+    hit: Vec<bool>,
     /// Jacobi iterations of the slowest block.
     pub iterations: usize,
 }
@@ -102,7 +115,46 @@ impl LightModel {
                 }
             }
         }
-        SensorCoefficients { sensors, slots, sky, sun, seen, iterations }
+        SensorCoefficients { sensors, slots, sky, sun, seen, hit: self.sides_hit(), iterations }
+    }
+
+    /// Which sides some sensor's rays land on.
+    fn sides_hit(&self) -> Vec<bool> {
+        let mut hit = vec![false; self.side_gathers.len()];
+        for run in self.sensors.iter().flat_map(|sensor| sensor.hits_by_side()) {
+            hit[run[0].0 as usize] = true;
+        }
+        hit
+    }
+
+    /// [`Self::sensor_coefficients`] through the light cache in `dir`:
+    /// read when it holds them for this model, else solved and stored
+    /// (not past [`MAX_CACHED_BYTES`]). What they depend on beyond the
+    /// gathers is every patch side's reflectance, so a model whose panels
+    /// were swapped ([`Self::set_panel_model`]) finds its own.
+    pub fn sensor_coefficients_cached(&self, dir: &Path) -> (SensorCoefficients, CacheOutcome) {
+        let (sensors, sides, slots) = (self.sensors.len(), self.side_gathers.len(), self.radiance_slots().len());
+        if (slots + sides) * sensors * size_of::<f32>() > MAX_CACHED_BYTES {
+            return (self.sensor_coefficients(), CacheOutcome::Skipped("too large to keep".into()));
+        }
+        let mut hash = Fnv::new();
+        hash.u64(cache::key(&self.scene, &self.settings)).u64(u64::from(FORMAT));
+        for side in 0..sides {
+            match self.side_reflectance(side) {
+                Some(rho) => rho.iter().fold(hash.u64(1), |h, r| h.f64(*r)),
+                None => hash.u64(0),
+            };
+        }
+        let key = hash.0;
+        let stored = cache::through_cache(
+            Some(dir),
+            &format!("{key:016x}-coefficients"),
+            key,
+            |payload| SensorCoefficients::from_payload(self, payload),
+            || Ok(self.sensor_coefficients()),
+            SensorCoefficients::payload,
+        );
+        stored.unwrap_or_else(|why| (self.sensor_coefficients(), CacheOutcome::Skipped(why)))
     }
 
     /// Column lists of the form factors: for side j, every (i, F_ij).
@@ -209,6 +261,39 @@ struct SunLux {
 }
 
 impl SensorCoefficients {
+    /// The coefficients as stored in the light cache.
+    fn payload(&self) -> Vec<u8> {
+        let mut w = Writer::default();
+        w.u32(self.sensors as u32);
+        w.u32(self.iterations as u32);
+        for values in [&self.sky, &self.sun] {
+            w.u32(values.len() as u32);
+            values.iter().for_each(|&v| w.f32(v));
+        }
+        self.seen.iter().for_each(|&seen| w.u32(u32::from(seen)));
+        w.0
+    }
+
+    /// Coefficients read back from the light cache; `None` when they do not
+    /// fit `model`.
+    fn from_payload(model: &LightModel, payload: &[u8]) -> Option<Self> {
+        let mut r = Reader(payload);
+        let (sensors, sides, slots) = (model.sensors.len(), model.side_gathers.len(), model.radiance_slots());
+        if r.u32()? as usize != sensors {
+            return None;
+        }
+        let iterations = r.u32()? as usize;
+        let mut values = |len: usize| -> Option<Vec<f32>> {
+            if r.u32()? as usize != len {
+                return None;
+            }
+            (0..len).map(|_| r.f32()).collect()
+        };
+        let (sky, sun) = (values(slots.len() * sensors)?, values(sides * sensors)?);
+        let seen = (0..sides).map(|_| r.u32().map(|v| v != 0)).collect::<Option<Vec<_>>>()?;
+        r.is_empty().then(|| Self { sensors, slots, sky, sun, seen, hit: model.sides_hit(), iterations })
+    }
+
     /// Every sensor's reading under `sky` (`threads` as [`par_map`]): equal
     /// to [`LightModel::solve`]'s up to its tolerance.
     pub fn readings(&self, model: &LightModel, sky: &Sky, threads: Option<usize>) -> Vec<SensorReading> {
@@ -250,7 +335,7 @@ impl SensorCoefficients {
     /// the later bounces from `path`.
     pub fn sun_response(&self, model: &LightModel, direction: DVec3, path: &SunPath, threads: Option<usize>) -> SunResponse {
         let beams = model.sun_beams(&SunSource::unit(direction));
-        let reach = model.sides_reach(&beams, Some(&self.seen), threads);
+        let reach = model.sides_reach(&beams, Some(&self.hit), threads);
         let first = self.first_bounce(model, &beams, &reach, threads);
         let direct = par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, &beams) * LUMINOUS_EFFICACY) as f32);
         let interreflected = first.iter().zip(path.later_bounces(direction)).map(|(first, later)| (first + later) as f32).collect();

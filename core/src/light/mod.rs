@@ -171,8 +171,11 @@ pub struct Lighting {
 /// blocks of indices as they finish the last, so uneven costs (sunrise and
 /// noon hours, patches in the open and in corners) keep every core busy.
 pub(crate) fn par_map<T: Send>(threads: Option<usize>, count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
-    let available = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let threads = threads.unwrap_or(available).max(1).min(count.max(1));
+    // Asked once: the standard library reads the cgroup files at every call,
+    // and hours of a year call this thousands of times.
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    let threads = threads.unwrap_or_else(|| *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get())));
+    let threads = threads.max(1).min(count.max(1));
     if threads == 1 {
         return (0..count).map(f).collect();
     }
