@@ -204,8 +204,14 @@ fn lit_app(name: &str) -> App {
     use heliodon::ecs::{self, LightCacheDir};
     use heliodon::light::LightSettings;
     let mut app = headless_app();
-    let settings =
-        LightSettings { rays_per_patch: 64, rays_per_sensor: 512, sun_samples_per_patch: 4, area_sensor_sun_grid: 4, ..Default::default() };
+    let settings = LightSettings {
+        rays_per_patch: 64,
+        rays_per_sensor: 512,
+        sky_rays_per_sensor: 512,
+        sun_samples_per_patch: 4,
+        area_sensor_sun_grid: 4,
+        ..Default::default()
+    };
     app.insert_resource(ecs::LightSettings(settings)).insert_resource(LightCacheDir(None));
     open(&mut app, heliodon::bundled_scene(name)).unwrap();
     app
@@ -411,6 +417,7 @@ fn the_day_series_of_a_sensor_follows_the_sun() {
     let settings = heliodon::light::LightSettings {
         rays_per_patch: 32,
         rays_per_sensor: 256,
+        sky_rays_per_sensor: 256,
         sun_samples_per_patch: 4,
         area_sensor_sun_grid: 4,
         ..Default::default()

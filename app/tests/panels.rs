@@ -93,7 +93,13 @@ fn winter_noon(scene: &heliodon::scene::Scene) -> heliodon::sky::Sky {
 }
 
 fn quick() -> heliodon::light::LightSettings {
-    heliodon::light::LightSettings { rays_per_patch: 16, rays_per_sensor: 64, sun_samples_per_patch: 64, ..Default::default() }
+    heliodon::light::LightSettings {
+        rays_per_patch: 16,
+        rays_per_sensor: 64,
+        sky_rays_per_sensor: 64,
+        sun_samples_per_patch: 64,
+        ..Default::default()
+    }
 }
 
 /// A panel whose one lobe goes straight on with its whole share passes the

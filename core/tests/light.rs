@@ -154,7 +154,14 @@ fn windows_given_their_own_material_change_alone() {
 }
 
 fn quick() -> LightSettings {
-    LightSettings { rays_per_patch: 64, rays_per_sensor: 512, sun_samples_per_patch: 4, area_sensor_sun_grid: 4, ..Default::default() }
+    LightSettings {
+        rays_per_patch: 64,
+        rays_per_sensor: 512,
+        sky_rays_per_sensor: 512,
+        sun_samples_per_patch: 4,
+        area_sensor_sun_grid: 4,
+        ..Default::default()
+    }
 }
 
 #[test]

@@ -114,6 +114,7 @@ pub fn key(scene: &Scene, settings: &LightSettings) -> u64 {
     }
     hash.u64(settings.rays_per_patch as u64)
         .u64(settings.rays_per_sensor as u64)
+        .u64(settings.sky_rays_per_sensor as u64)
         .u64(settings.sun_samples_per_patch as u64)
         .u64(settings.area_sensor_sun_grid as u64)
         .u64(u64::from(settings.sky_subdivision))

@@ -27,7 +27,7 @@ pub fn memory_budget_mib() -> u64 {
 /// sensor ray (a share, and where the ray landed).
 fn check_memory(scene: &Scene, settings: &LightSettings) -> Result<(), String> {
     let sides = 2.0 * scene.patches.patches.len() as f64 * settings.rays_per_patch as f64 * 8.0;
-    let sensors = scene.sensors.len() as f64 * settings.rays_per_sensor as f64 * 28.0;
+    let sensors = scene.sensors.len() as f64 * settings.sky_rays_per_sensor.max(settings.rays_per_sensor) as f64 * 28.0;
     let (need, budget) = ((sides + sensors) / 1048576.0, memory_budget_mib() as f64);
     if need > budget {
         return Err(format!(
@@ -273,16 +273,23 @@ impl LightModel {
         };
         let mut rng = Rng::new(2, index as u64);
         let per_point = self.settings.rays_per_sensor.div_ceil(points.len());
+        let more_per_point = self.settings.sky_rays_per_sensor.saturating_sub(self.settings.rays_per_sensor).div_ceil(points.len());
         let (mut coefficients, mut hits) = (Vec::new(), Vec::new());
-        for &point in &points {
-            for dir in cosine_directions(normal, per_point, &mut rng) {
-                self.follow(point, dir, 1.0, 0, None, &mut coefficients, &mut hits);
+        let mut trace = |count: usize, coefficients: &mut Vec<(u32, f64)>, hits: &mut Vec<SideHit>| {
+            for &point in &points {
+                for dir in cosine_directions(normal, count, &mut rng) {
+                    self.follow(point, dir, 1.0, 0, None, coefficients, hits);
+                }
             }
-        }
-        let rays = per_point * points.len();
-        let gather = Gather::from_raw(coefficients, &hits, rays);
-        let hits = hits.iter().map(|h| (h.side, (h.weight / rays as f64) as f32, h.point.as_vec3().to_array())).collect();
-        SensorGeometry::new(gather, sun_points, normal, hits)
+            count * points.len()
+        };
+        // The first rays' landings keep the sun's first bounce; more rays,
+        // a second stratified set, refine the sky and form factors.
+        let bounce_rays = trace(per_point, &mut coefficients, &mut hits);
+        let bounce: Vec<(u32, f32, [f32; 3])> =
+            hits.iter().map(|h| (h.side, (h.weight / bounce_rays as f64) as f32, h.point.as_vec3().to_array())).collect();
+        let rays = bounce_rays + trace(more_per_point, &mut coefficients, &mut hits);
+        SensorGeometry::new(Gather::from_raw(coefficients, &hits, rays), sun_points, normal, bounce)
     }
 }
 

@@ -6,8 +6,17 @@
 pub struct LightSettings {
     /// Hemisphere rays from each side of each patch (form factors, sky coefficients).
     pub rays_per_patch: usize,
-    /// Hemisphere rays from each sensor point.
+    /// Hemisphere rays from each sensor point whose landings keep the
+    /// sun's first bounce (traced there every relight and every hour of a
+    /// year).
     pub rays_per_sensor: usize,
+    /// Hemisphere rays from each sensor point for its sky and form factors,
+    /// the first `rays_per_sensor` included (so at least those). The sky a deep sensor sees
+    /// through distant windows is a small solid angle: at 4,096 rays the
+    /// validation room's mirror-image sensors read up to 6% apart under an
+    /// overcast sky, at 16,384 its overcast p90 against Radiance went from
+    /// 3.1% to 2.3%. Only the gather costs more; nothing per relight.
+    pub sky_rays_per_sensor: usize,
     /// Shadow rays toward the sun per patch side. A sample toggles as a
     /// shadow edge crosses it, so the sun's bounced light moves in steps of
     /// 1/n of a side's beam: at 64 an hour read between sun positions (the
@@ -34,6 +43,7 @@ impl Default for LightSettings {
         Self {
             rays_per_patch: 256,
             rays_per_sensor: 4096,
+            sky_rays_per_sensor: 16384,
             sun_samples_per_patch: 64,
             area_sensor_sun_grid: 32,
             sky_subdivision: 4,
