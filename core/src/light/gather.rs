@@ -27,7 +27,9 @@ pub fn memory_budget_mib() -> u64 {
 /// sensor ray (a share, and where the ray landed).
 fn check_memory(scene: &Scene, settings: &LightSettings) -> Result<(), String> {
     let sides = 2.0 * scene.patches.patches.len() as f64 * settings.rays_per_patch as f64 * 8.0;
-    let sensors = scene.sensors.len() as f64 * settings.sky_rays_per_sensor.max(settings.rays_per_sensor) as f64 * 28.0;
+    // Only the first `rays_per_sensor` rays' landings are kept; the rest of a
+    // sensor's sky rays live while it gathers.
+    let sensors = scene.sensors.len() as f64 * settings.rays_per_sensor as f64 * 28.0;
     let (need, budget) = ((sides + sensors) / 1048576.0, memory_budget_mib() as f64);
     if need > budget {
         return Err(format!(
