@@ -157,6 +157,63 @@ fn a_redirecting_tensor_tree_sends_the_sun_to_the_ceiling() {
     assert!(sum(&redirected, "floor") < 0.1 * sum(&redirected, "ceiling"), "{redirected:?}");
 }
 
+/// Sensors read a measured panel's data itself, not its lobes' beams: a
+/// tensor tree (written here) sends the light of every incoming direction
+/// evenly into a block of outgoing leaves 22-39° below the horizontal, so
+/// that each floor sensor sees only part of the window through it. The
+/// sensors' direct sun is the data's integral over the window, Eₙ cos θᵢ ∫
+/// f cos θₛ cos θₒ dA / r² (a 400 × 400 midpoint sum here, by the tree's
+/// own lookup), within 1%; the lobe's three beams, all or nothing at each
+/// sensor, are printed beside it.
+#[test]
+fn sensors_read_a_measured_panels_data_not_its_beams() {
+    use heliodon_bsdf::tensor_tree::TensorTree;
+    use std::sync::Arc;
+    // 16 leaves per axis, the first axis slowest; outgoing leaves u 7-8, v 3-4 hold the light.
+    let leaves = 16;
+    let lit = |u: usize, v: usize| (7..=8).contains(&u) && (3..=4).contains(&v);
+    let values: Vec<&str> =
+        (0..leaves * leaves * leaves * leaves).map(|k| if lit((k / leaves) % leaves, k % leaves) { "12" } else { "0" }).collect();
+    let data = format!("{{ {} }}", values.join(" "));
+    let tree = TensorTree::parse(&data, 4).unwrap();
+    let xml = format!(
+        "<?xml version=\"1.0\"?>\n<WindowElement><Optical><Layer><DataDefinition><IncidentDataStructure>TensorTree4</IncidentDataStructure></DataDefinition>\n<WavelengthData><Wavelength unit=\"Integral\">Visible</Wavelength><WavelengthDataBlock><WavelengthDataDirection>Transmission Front</WavelengthDataDirection><AngleBasis>LBNL/Shirley-Chiu</AngleBasis><ScatteringDataType>BTDF</ScatteringDataType>\n<ScatteringData>\n{data}\n</ScatteringData></WavelengthDataBlock></WavelengthData>\n</Layer></Optical></WindowElement>\n"
+    );
+    let path = room("block", Some("panel = \"bsdf\"\nfile = \"block.xml\"\nlobe_width = 40.0\n"));
+    std::fs::write(path.with_file_name("block.xml"), xml).unwrap();
+    let scene = Arc::new(load_scene(&path, &all_panels()).unwrap().scene);
+    let sky = winter_noon(&scene);
+    let sun = sky.sun_up().unwrap();
+    let model = heliodon::light::LightModel::precompute(scene.clone(), quick()).unwrap();
+    let readings = model.solve(&sky, None).sensors;
+    // The panel frame of the south window: x = −x (west), y = up, z = north, into the room.
+    let to_panel = |d: heliodon::glam::DVec3| heliodon::glam::DVec3::new(-d.x, d.z, d.y);
+    let travel = to_panel(-sun.direction);
+    let n = 400;
+    // Where the engine measures: 1 cm off the floor.
+    let points = heliodon::light::sensor_points(&scene);
+    for ((reading, sensor), points) in readings.iter().zip(&scene.sensors).zip(&points) {
+        let p = points[0];
+        let mut integral = 0.0;
+        for k in 0..n * n {
+            let q = heliodon::glam::DVec3::new(1.0 + 2.0 * ((k / n) as f64 + 0.5) / n as f64, 0.0, 1.0 + ((k % n) as f64 + 0.5) / n as f64);
+            let (to_sensor, r2) = ((p - q).normalize(), p.distance_squared(q));
+            let out = to_panel(to_sensor);
+            integral += tree.value(-travel, out) * out.z * -to_sensor.z * (2.0 / (n * n) as f64) / r2;
+        }
+        let expected = sun.normal_irradiance() * travel.z * integral * heliodon::sky::LUMINOUS_EFFICACY;
+        let beams = model.beams_irradiance(p, sensor.normal.as_dvec3(), &model.sun_beams(&sun)) * heliodon::sky::LUMINOUS_EFFICACY;
+        println!(
+            "{}: direct sun {:.0} lux, the data's {expected:.0} ({:+.2}%); the lobe's beams would give {beams:.0}",
+            reading.name,
+            reading.direct_sun,
+            100.0 * (reading.direct_sun / expected - 1.0),
+        );
+        assert!(expected > 100.0, "{}: the sensor sees the light through the block: {expected}", reading.name);
+        assert!((reading.direct_sun / expected - 1.0).abs() < 0.01, "{}: {} vs {expected}", reading.name, reading.direct_sun);
+    }
+}
+
 /// A panel's room side returns its back reflectance of the room's light:
 /// an opaque panel (transmittance 0) reflecting half of it back lights the
 /// room as a diffuse wall of reflectance 0.5 in its place does, and one

@@ -58,8 +58,8 @@ pub mod panel_guide {}
 /// directions.
 pub mod prelude {
     pub use crate::panel::{
-        Key, KeyKind, Lobe, PanelCatalog, PanelModel, PanelResponse, PanelType, ParameterError, Parameters, fresnel_reflectance, reflect,
-        refract,
+        Key, KeyKind, Lobe, MeasuredTransmission, PanelCatalog, PanelModel, PanelResponse, PanelType, ParameterError, Parameters,
+        fresnel_reflectance, reflect, refract,
     };
     pub use glam::DVec3;
 }

@@ -29,7 +29,7 @@ use crate::sun::{direction_from_angles, solar_position};
 use crate::weather::{HOURS, calendar};
 
 /// Bump when the table or how it is traced changes.
-const FORMAT: u32 = 1;
+const FORMAT: u32 = 2;
 
 /// The most a table may take on disk, bytes. Past it (a grid of tens of
 /// thousands of sensors) the year's sun is traced hour by hour instead
@@ -282,8 +282,9 @@ fn through_shades(model: &LightModel, direction: DVec3, groups: usize) -> Vec<f3
         return through;
     }
     let beams = model.sun_beams(&SunSource::unit(direction));
+    let measured = model.measured_sun(&beams);
     for i in 0..sensors {
-        for (window, e) in model.sensor_sun_by_window(i, &beams) {
+        for (window, e) in model.sensor_sun_by_window(i, &beams, &measured) {
             let Some(window) = window else { continue };
             for (g, group) in scene.shades.iter().enumerate().take(groups) {
                 if scene.windows[window as usize].material == group.windows {

@@ -298,7 +298,8 @@ impl SensorCoefficients {
     /// to [`LightModel::solve`]'s up to its tolerance.
     pub fn readings(&self, model: &LightModel, sky: &Sky, threads: Option<usize>) -> Vec<SensorReading> {
         let beams = sky.sun_up().map(|s| model.sun_beams(&s)).unwrap_or_default();
-        let direct = par_map(threads, model.sensors.len(), |i| model.sensor_direct_sun(i, &beams) * LUMINOUS_EFFICACY);
+        let measured = model.measured_sun(&beams);
+        let direct = par_map(threads, model.sensors.len(), |i| model.sensor_direct_sun(i, &beams, &measured) * LUMINOUS_EFFICACY);
         self.read(model, sky, SunLux { direct, interreflected: self.interreflected_sun(model, &beams, threads) }, threads)
     }
 
@@ -337,7 +338,8 @@ impl SensorCoefficients {
         let beams = model.sun_beams(&SunSource::unit(direction));
         let reach = model.sides_reach(&beams, Some(&self.hit), threads);
         let first = self.first_bounce(model, &beams, &reach, threads);
-        let direct = par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, &beams) * LUMINOUS_EFFICACY) as f32);
+        let measured = model.measured_sun(&beams);
+        let direct = par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, &beams, &measured) * LUMINOUS_EFFICACY) as f32);
         let interreflected = first.iter().zip(path.later_bounces(direction)).map(|(first, later)| (first + later) as f32).collect();
         SunResponse { direct, interreflected }
     }

@@ -127,13 +127,15 @@ pub(super) struct SensorGeometry {
     pub(super) hits: Vec<(u32, f32, [f32; 3])>,
     /// Where each side's run of `hits` ends.
     run_ends: Vec<u32>,
+    /// The panels' window points it sees, per panel group, found on first use.
+    pub(super) panel_views: std::sync::OnceLock<Vec<Vec<super::measured::SeenSample>>>,
 }
 
 impl SensorGeometry {
     pub(super) fn new(gather: Gather, sun_points: Vec<DVec3>, normal: DVec3, mut hits: Vec<(u32, f32, [f32; 3])>) -> Self {
         hits.sort_by_key(|h| h.0);
         let run_ends = (1..=hits.len()).filter(|&k| k == hits.len() || hits[k].0 != hits[k - 1].0).map(|k| k as u32).collect();
-        Self { sun_points, normal, gather, hits, run_ends }
+        Self { sun_points, normal, gather, hits, run_ends, panel_views: std::sync::OnceLock::new() }
     }
 
     /// The hits, a run per side.

@@ -33,6 +33,7 @@ pub mod coefficients;
 pub mod daylight;
 pub mod gather;
 mod glass;
+mod measured;
 mod openings;
 pub mod panels;
 mod sampling;
@@ -48,6 +49,7 @@ use glam::DVec3;
 pub use coefficients::{SensorCoefficients, SunPath};
 pub use gather::{Gather, SkyKey, sensor_points, side_of};
 pub use glass::Glass;
+pub use measured::MeasuredSun;
 pub use panels::{PanelFrame, SunBeam};
 pub use settings::LightSettings;
 pub use solver::{Interreflection, Relight, form_factor_product};
@@ -100,6 +102,9 @@ pub struct LightModel {
     /// Panel windows by material and orientation, and each surface's group.
     panel_groups: Vec<panels::PanelGroup>,
     group_of_surface: Vec<Option<u32>>,
+    /// Per panel group, points on its windows (sensors' direct sun through
+    /// measured panels, [`measured`]).
+    panel_samples: Vec<measured::WindowSamples>,
     /// Where the sun can come in (spares shadow rays).
     openings: openings::Openings,
     /// Per patch side (2 per patch; empty for glass and the outer side of panels).
@@ -248,6 +253,7 @@ impl LightModel {
             window_of_surface,
             panel_groups,
             group_of_surface,
+            panel_samples: Vec::new(),
             openings,
             scene,
             settings,
@@ -258,6 +264,7 @@ impl LightModel {
             sensors: Vec::new(),
         };
         model.look_out_of_panels();
+        model.panel_samples = (0..model.panel_groups.len()).map(|g| model.window_samples(g)).collect();
         model
     }
 
@@ -328,6 +335,8 @@ impl LightModel {
         for group in self.panel_groups.iter_mut().filter(|g| g.material == material) {
             group.set_model(model.clone());
         }
+        // Which data cells the sensors see the windows in is the model's.
+        self.sensors.iter_mut().for_each(|s| s.panel_views = std::sync::OnceLock::new());
     }
 
     /// The back reflectance of panel material `material`'s windows, as the

@@ -7,10 +7,11 @@
 use glam::DVec3;
 
 use super::gather::sample_area;
+use super::measured::MeasuredSun;
 use super::openings::WayIn;
 use super::panels::{self, SunBeam};
 use super::sampling::Rng;
-use super::{LightModel, MAX_GLASS_DEPTH, SURFACE_OFFSET, Surface, par_map};
+use super::{LightModel, SURFACE_OFFSET, Surface, par_map};
 use crate::sky::SunSource;
 
 /// The sun's beams on every patch side, and where they may land.
@@ -92,20 +93,8 @@ impl LightModel {
     /// the ray must leave through a window of the lobe's panel group (glass
     /// on the way counts), and from there the real sun must reach it.
     fn lobe_transmittance(&self, point: DVec3, to_light: DVec3, group: u32, sun: DVec3) -> f64 {
-        let (mut origin, mut transmittance) = (point, 1.0);
-        for _ in 0..=MAX_GLASS_DEPTH {
-            let Some(hit) = self.shadow_tracer.closest(origin, to_light, 1e-6) else { return 0.0 };
-            let at = origin + to_light * hit.distance;
-            match self.surface_kind(hit.patch) {
-                Surface::Panel(g) if g == group => return transmittance * self.sun_transmittance(at + sun * SURFACE_OFFSET, sun),
-                Surface::Glass(glass) => {
-                    transmittance *= glass.at(to_light.dot(self.scene.surfaces[hit.patch as usize].normal.as_dvec3())).0
-                }
-                _ => return 0.0,
-            }
-            origin = at + to_light * SURFACE_OFFSET;
-        }
-        0.0
+        self.reaches_panel(point, to_light, group)
+            .map_or(0.0, |(at, transmittance)| transmittance * self.sun_transmittance(at + sun * SURFACE_OFFSET, sun))
     }
 
     /// The beams of direct sunlight for a sun: itself and its panel lobes.
@@ -162,10 +151,15 @@ impl LightModel {
         }
     }
 
-    /// Sensor `index`'s direct sun (W/m², averaged over its sun points).
-    /// An enclosed sensor (no gather ray reached the open sky) is traced
-    /// only along beams that may pass a window, as sides are.
-    pub(super) fn sensor_direct_sun(&self, index: usize, beams: &[SunBeam]) -> f64 {
+    /// Sensor `index`'s direct sun (W/m², averaged over its sun points):
+    /// the beams, and through panels with measured transmission their data
+    /// (`measured`, [`Self::measured_sun`] of the same beams) in place of
+    /// their beams. An enclosed sensor (no gather ray reached the open sky)
+    /// is traced only along beams that may pass a window, as sides are.
+    pub(super) fn sensor_direct_sun(&self, index: usize, beams: &[SunBeam], measured: &MeasuredSun) -> f64 {
+        let through_data: f64 = self.sensor_measured_sun(index, measured).iter().map(|w| w.1).sum();
+        let beams: Vec<SunBeam> = beams.iter().filter(|b| !measured.covers(b.panel_group)).copied().collect();
+        let beams = &beams[..];
         let geometry = &self.sensors[index];
         let reach = if self.sees_open_sky(&geometry.gather) || beams.is_empty() {
             Reach::Open
@@ -175,7 +169,7 @@ impl LightModel {
             Reach::Through(self.openings.ways_into_sphere(centre, radius, beams))
         };
         let total: f64 = geometry.sun_points.iter().map(|&p| self.reaching_irradiance(&reach, p, geometry.normal, beams)).sum();
-        total / geometry.sun_points.len() as f64
+        total / geometry.sun_points.len() as f64 + through_data
     }
 
     /// The first bounce of the beams off the sides sensor `index`'s rays
@@ -232,14 +226,15 @@ impl LightModel {
     /// `None`: straight from the sky).
     ///
     /// [`Scene::windows`]: crate::scene::Scene::windows
-    pub fn sensor_sun_by_window(&self, index: usize, beams: &[SunBeam]) -> Vec<(Option<u32>, f64)> {
+    pub fn sensor_sun_by_window(&self, index: usize, beams: &[SunBeam], measured: &MeasuredSun) -> Vec<(Option<u32>, f64)> {
         let geometry = &self.sensors[index];
         let sun = beams.first().map_or(DVec3::Z, |b| b.to_light);
-        let mut by_window: Vec<(Option<u32>, f64)> = Vec::new();
+        let mut by_window: Vec<(Option<u32>, f64)> =
+            self.sensor_measured_sun(index, measured).into_iter().map(|(window, e)| (Some(window), e)).collect();
         let share = 1.0 / geometry.sun_points.len() as f64;
         for &point in &geometry.sun_points {
             let origin = point + geometry.normal * SURFACE_OFFSET;
-            for beam in beams {
+            for beam in beams.iter().filter(|b| !measured.covers(b.panel_group)) {
                 let e = self.beam_irradiance(origin, geometry.normal, beam, sun);
                 if e > 0.0 {
                     let hit = self.shadow_tracer.closest(origin, beam.to_light, 1e-6);

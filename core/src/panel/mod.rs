@@ -82,6 +82,31 @@ pub trait PanelModel: Send + Sync + fmt::Debug {
     fn bsdf_file(&self) -> Option<&Path> {
         None
     }
+
+    /// The measured transmission behind the lobes, where the model has it.
+    /// Sensors then take the direct sun through the panel from the data,
+    /// integrated over the windows they see, rather than from the lobes'
+    /// beams, which land where a lobe's middle does. `None` (the default):
+    /// the lobes are all the model has.
+    fn measured(&self) -> Option<&dyn MeasuredTransmission> {
+        None
+    }
+}
+
+/// A panel's measured transmission (BTDF, 1/sr: lobes and diffuse part
+/// together) from outside into the room, read as Radiance reads the data:
+/// constant over cells of outgoing directions (a Klems basis's patches, a
+/// tensor tree's finest leaves). A sensor finds the cell of each direction
+/// it sees a window in once; each sun then costs one row of the data.
+pub trait MeasuredTransmission: Send + Sync {
+    /// The cells the outgoing directions fall in.
+    fn outgoing_cells(&self) -> usize;
+    /// The cell (below [`Self::outgoing_cells`]) holding `outgoing`, the
+    /// way light leaves into the room (unit, panel frame, z > 0).
+    fn outgoing_cell(&self, outgoing: DVec3) -> usize;
+    /// The BTDF into every outgoing cell for light travelling along
+    /// `incoming` (unit, panel frame, z > 0).
+    fn row(&self, incoming: DVec3) -> Vec<f64>;
 }
 
 /// A kind of panel, registered by name: builds models from scene-file keys.

@@ -15,7 +15,12 @@
 //! tensor tree's are its leaves: it is read at the middle of each incoming
 //! leaf (up to 32 per axis), into 32 × 32 outgoing bins of equal projected
 //! solid angle (the Shirley–Chiu square), each the mean of the tree's
-//! leaves over the bin.
+//! leaves over the bin. A tree is constant over an incoming leaf and
+//! Radiance reads it so, without interpolation; so does the fit: a query
+//! takes the fit of the leaf holding it (of a 3-D tree, the leaf's sample
+//! nearest in azimuth, turned to the query's azimuth, as the tree turns
+//! with the light). A metal-slat tree's transmittance can step from 0.08
+//! to 0.21 between two leaves 1° apart; a blend there would be neither.
 //!
 //! Each lobe is as wide as the light it stands for (2√2 times the RMS angle
 //! of its flux, the bins' own extent included, at most the cone), so the
@@ -38,8 +43,8 @@ pub mod xml;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use heliodon_core::glam::DVec3;
-use heliodon_core::panel::{Key, Lobe, PanelModel, PanelResponse, PanelType, ParameterError, Parameters};
+use heliodon_core::glam::{DQuat, DVec3};
+use heliodon_core::panel::{Key, Lobe, MeasuredTransmission, PanelModel, PanelResponse, PanelType, ParameterError, Parameters};
 use spade::{DelaunayTriangulation, FloatTriangulation, Point2, Triangulation};
 
 use tensor_tree::{TensorTree, cell_direction};
@@ -155,8 +160,9 @@ struct Bins {
 /// the transmitted flux into each outgoing bin and the hemispherical
 /// reflectance, both for light from outside.
 struct Measured {
-    /// The way the light travels, panel frame.
-    incoming: Vec<DVec3>,
+    /// How a query direction finds the measured directions (the way the
+    /// light travels, panel frame) it is read from.
+    lookup: Lookup,
     /// The outgoing bins.
     bins: Bins,
     /// Share of the incoming flux into each bin, `[incoming][bin]`.
@@ -186,11 +192,11 @@ impl Measured {
                     (0..patches.len()).map(|o| get(i, o) * patches[o].1).collect::<Vec<f64>>()
                 };
                 Self {
+                    lookup: Lookup::blend(&directions),
                     flux: (0..patches.len()).map(|i| hemisphere(i, &|i, o| transmission.get(i, o))).collect(),
                     reflected: (0..patches.len())
                         .map(|i| reflection.as_ref().map_or(0.0, |r| hemisphere(i, &|i, o| r.get(i, o)).iter().sum()))
                         .collect(),
-                    incoming: directions.clone(),
                     bins: Bins { directions, solid_angles: klems_solid_angles(basis) },
                 }
             }
@@ -224,7 +230,9 @@ impl Measured {
         let weight = std::f64::consts::PI / (side * side) as f64;
         // A coarse tree is read at 8 leaves per axis at least: a uniform one
         // (a single leaf) still has directions all round.
-        let incoming = tree_incoming(transmission.dims(), finest.clamp(8, TREE_INCOMING));
+        let cells = finest.clamp(8, TREE_INCOMING);
+        let incoming = tree_incoming(transmission.dims(), cells);
+        let lookup = if transmission.dims() == 4 { Lookup::Square { cells } } else { Lookup::rings(cells) };
         let mut flux = Vec::with_capacity(incoming.len());
         let mut reflected = Vec::with_capacity(incoming.len());
         for &travel in &incoming {
@@ -237,7 +245,7 @@ impl Measured {
             flux.push(bin_flux);
             reflected.push(reflection.map_or(0.0, |r| points.iter().map(|&(_, back, _)| r.value(-travel, back) * weight).sum()));
         }
-        Self { incoming, bins, flux, reflected }
+        Self { lookup, bins, flux, reflected }
     }
 }
 
@@ -267,12 +275,16 @@ fn back_reflectance(file: &BsdfFile) -> f64 {
     rho.clamp(0.0, 1.0)
 }
 
+/// Azimuths a 3-D tree is read at on a ring of sin θ, 3.75° apart or fewer
+/// near the normal: the fit of the one nearest a query is turned to it.
+fn ring_azimuths(sin: f64) -> usize {
+    ((96.0 * sin).ceil() as usize).max(4)
+}
+
 /// The directions (the way light travels) at the middles of a tree's
 /// incoming leaves, `cells` per axis: for a 4-D tree each cell of the
 /// incoming square; for a 3-D tree each ring of its sin θ axis (½ − ½ sin θ,
-/// the axis's used half), at azimuths 3.75° apart or fewer near the
-/// normal (the tree turns with the azimuth; so many that a direction
-/// between two of a ring is blended from them, not from the next ring).
+/// the axis's used half), at [`ring_azimuths`].
 fn tree_incoming(dims: usize, cells: usize) -> Vec<DVec3> {
     let on_hemisphere = |[x, y]: [f64; 2]| DVec3::new(x, y, (1.0 - x * x - y * y).max(0.0).sqrt());
     let middle = |k: usize| (k as f64 + 0.5) / cells as f64;
@@ -282,7 +294,7 @@ fn tree_incoming(dims: usize, cells: usize) -> Vec<DVec3> {
         (0..cells / 2)
             .flat_map(|k| {
                 let sin = 1.0 - 2.0 * middle(k);
-                let azimuths = ((96.0 * sin).ceil() as usize).max(4);
+                let azimuths = ring_azimuths(sin);
                 (0..azimuths).map(move |a| {
                     let phi = std::f64::consts::TAU * a as f64 / azimuths as f64;
                     on_hemisphere([sin * phi.cos(), sin * phi.sin()])
@@ -292,13 +304,185 @@ fn tree_incoming(dims: usize, cells: usize) -> Vec<DVec3> {
     }
 }
 
+/// Outgoing cells per axis of a tensor tree's square, at most (its finest
+/// leaves, as long as they are no finer). A 3-D tree turns its outgoing
+/// square with the light, so its leaves cross the cells: twice its finest
+/// leaves, up to this, keeps them within a cell's width.
+const TREE_CELLS: usize = 64;
+
+/// A file's transmission from outside into the room, looked up as
+/// Radiance does: the Klems patch or tree leaf holding the directions.
+enum Transmission {
+    Klems {
+        /// Per ring: θ from, θ to (radians) and its first patch and count.
+        rings: Vec<(f64, f64, usize, usize)>,
+        matrix: xml::Matrix,
+    },
+    Tree {
+        tree: TensorTree,
+        /// Only "Transmission Back" was given: read it by reciprocity.
+        reciprocal: bool,
+        /// Outgoing cells per axis of the square.
+        cells: usize,
+    },
+}
+
+impl Transmission {
+    fn of(file: &BsdfFile) -> Self {
+        match &file.scattering {
+            Scattering::Klems { basis, transmission, .. } => {
+                let mut start = 0;
+                let rings = basis
+                    .rings
+                    .iter()
+                    .map(|r| {
+                        start += r.phis;
+                        (r.theta_low.to_radians(), r.theta_high.to_radians(), start - r.phis, r.phis)
+                    })
+                    .collect();
+                Self::Klems { rings, matrix: transmission.clone() }
+            }
+            Scattering::TensorTree { transmission, reciprocal, .. } => {
+                let finest = (1.0 / transmission.smallest_leaf()).round() as usize;
+                let cells = if transmission.dims() == 4 { finest.min(TREE_CELLS) } else { (2 * finest).min(TREE_CELLS) };
+                Self::Tree { tree: transmission.clone(), reciprocal: *reciprocal, cells: cells.max(1) }
+            }
+        }
+    }
+
+    /// The Klems patch holding `direction` (bsdf_m.c: a ring by θ, then
+    /// the patch whose middle φ is nearest).
+    fn patch(rings: &[(f64, f64, usize, usize)], direction: DVec3) -> usize {
+        let theta = direction.z.clamp(-1.0, 1.0).acos();
+        let &(_, _, start, count) = rings.iter().find(|r| theta < r.1).unwrap_or(&rings[rings.len() - 1]);
+        let phi = direction.y.atan2(direction.x).rem_euclid(std::f64::consts::TAU);
+        start + (phi / std::f64::consts::TAU * count as f64 + 0.5) as usize % count
+    }
+}
+
+impl MeasuredTransmission for Transmission {
+    fn outgoing_cells(&self) -> usize {
+        match self {
+            Self::Klems { matrix, .. } => matrix.values.len() / matrix.incoming,
+            Self::Tree { cells, .. } => cells * cells,
+        }
+    }
+
+    fn outgoing_cell(&self, outgoing: DVec3) -> usize {
+        match self {
+            Self::Klems { rings, .. } => Self::patch(rings, outgoing),
+            Self::Tree { cells, .. } => {
+                let cell = |x: f64| ((x * *cells as f64) as usize).min(cells - 1);
+                let [u, v] = tensor_tree::disk_to_square(outgoing.x, outgoing.y);
+                cell(u) * cells + cell(v)
+            }
+        }
+    }
+
+    fn row(&self, incoming: DVec3) -> Vec<f64> {
+        let row = match self {
+            Self::Klems { rings, matrix } => {
+                let patch = Self::patch(rings, incoming);
+                (0..matrix.values.len() / matrix.incoming).map(|o| matrix.get(patch, o)).collect::<Vec<f64>>()
+            }
+            Self::Tree { tree, reciprocal, cells } => (0..cells * cells)
+                .map(|k| {
+                    let out = cell_direction(k, *cells, 1.0);
+                    if *reciprocal { tree.value(out, -incoming) } else { tree.value(-incoming, out) }
+                })
+                .collect(),
+        };
+        row.into_iter().map(|f| f.max(0.0)).collect()
+    }
+}
+
+/// How a query direction finds the measured directions it is read from.
+enum Lookup {
+    /// A Klems file: the three measured directions around it, blended.
+    Blend {
+        /// Measured incoming directions projected on the panel plane.
+        triangulation: DelaunayTriangulation<Point2<f64>>,
+        /// Vertex index in the triangulation → measured direction.
+        vertex_patch: Vec<usize>,
+    },
+    /// A 4-D tree: the incoming leaf holding it, `cells` per axis of the
+    /// square (the measured directions in [`tree_incoming`]'s order).
+    Square { cells: usize },
+    /// A 3-D tree: the ring of sin θ holding it (each ring's first
+    /// measured direction and its count, `cells` = 2 × rings), and on it
+    /// the sample nearest in azimuth.
+    Rings(Vec<(usize, usize)>),
+}
+
+impl Lookup {
+    fn blend(incoming: &[DVec3]) -> Self {
+        let mut triangulation = DelaunayTriangulation::<Point2<f64>>::new();
+        let mut vertex_patch = Vec::new();
+        for (i, d) in incoming.iter().enumerate() {
+            if let Ok(handle) = triangulation.insert(Point2::new(d.x, d.y))
+                && handle.index() == vertex_patch.len()
+            {
+                vertex_patch.push(i);
+            }
+        }
+        Self::Blend { triangulation, vertex_patch }
+    }
+
+    /// The rings of a 3-D tree read at `cells` leaves per axis.
+    fn rings(cells: usize) -> Self {
+        let mut start = 0;
+        Self::Rings(
+            (0..cells / 2)
+                .map(|k| {
+                    let count = ring_azimuths(1.0 - 2.0 * (k as f64 + 0.5) / cells as f64);
+                    start += count;
+                    (start - count, count)
+                })
+                .collect(),
+        )
+    }
+
+    /// The measured directions `incoming` (panel frame, z > 0) is read
+    /// from with their weights, and the turn about z (radians) to give
+    /// their lobes.
+    fn find(&self, incoming: DVec3) -> (Vec<(usize, f64)>, f64) {
+        match self {
+            Self::Blend { triangulation, vertex_patch } => {
+                let position = Point2::new(incoming.x, incoming.y);
+                let mut weights = Vec::new();
+                triangulation.barycentric().get_weights(position, &mut weights);
+                if weights.is_empty() {
+                    // Beyond the outermost measured ring: the nearest measurement.
+                    if let Some(nearest) = triangulation.nearest_neighbor(position) {
+                        weights.push((nearest.fix(), 1.0));
+                    }
+                }
+                (weights.iter().map(|(v, w)| (vertex_patch[v.index()], *w)).collect(), 0.0)
+            }
+            Self::Square { cells } => {
+                let cell = |x: f64| ((x * *cells as f64) as usize).min(cells - 1);
+                let [u, v] = tensor_tree::disk_to_square(incoming.x, incoming.y);
+                (vec![(cell(u) * cells + cell(v), 1.0)], 0.0)
+            }
+            Self::Rings(rings) => {
+                // The tree's first axis, ½ − ½ sin θ, over its used half.
+                let ring = (((1.0 - incoming.x.hypot(incoming.y)) * rings.len() as f64) as usize).min(rings.len() - 1);
+                let (start, count) = rings[ring];
+                let step = std::f64::consts::TAU / count as f64;
+                let azimuth = incoming.y.atan2(incoming.x).rem_euclid(std::f64::consts::TAU);
+                let nearest = (azimuth / step).round();
+                (vec![(start + nearest as usize % count, 1.0)], azimuth - nearest * step)
+            }
+        }
+    }
+}
+
 /// A BSDF fitted to lobes at every measured incoming direction.
 pub struct BsdfModel {
     fitted: Vec<Fitted>,
-    /// Measured incoming directions projected on the panel plane.
-    triangulation: DelaunayTriangulation<Point2<f64>>,
-    /// Vertex index in the triangulation → measured direction.
-    vertex_patch: Vec<usize>,
+    lookup: Lookup,
+    /// The file's transmission, for [`PanelModel::transmission`].
+    data: Transmission,
     /// Share of the transmitted flux the lobes represent, over all measured
     /// directions (flux-weighted): how well `lobes` of `lobe_width` fit.
     pub captured: f64,
@@ -335,22 +519,9 @@ impl BsdfModel {
                 Fitted { lobes, diffuse_transmittance: rest * scale, diffuse_reflectance: reflected.min(1.0 - total * scale).max(0.0) }
             })
             .collect();
-        let mut triangulation = DelaunayTriangulation::<Point2<f64>>::new();
-        let mut vertex_patch = Vec::new();
-        for (i, d) in measured.incoming.iter().enumerate() {
-            if let Ok(handle) = triangulation.insert(Point2::new(d.x, d.y))
-                && handle.index() == vertex_patch.len()
-            {
-                vertex_patch.push(i);
-            }
-        }
         let captured = if transmitted > 0.0 { captured / transmitted } else { 1.0 };
-        Self { fitted, triangulation, vertex_patch, captured, file: None, back_reflectance: back_reflectance(file) }
-    }
-
-    /// The fitted response at measured direction `patch`.
-    fn at(&self, patch: usize) -> &Fitted {
-        &self.fitted[patch]
+        let data = Transmission::of(file);
+        Self { fitted, lookup: measured.lookup, data, captured, file: None, back_reflectance: back_reflectance(file) }
     }
 }
 
@@ -360,16 +531,9 @@ impl PanelModel for BsdfModel {
         if incoming.z <= 0.0 {
             return PanelResponse::default();
         }
-        let position = Point2::new(incoming.x, incoming.y);
-        let mut weights = Vec::new();
-        self.triangulation.barycentric().get_weights(position, &mut weights);
-        if weights.is_empty() {
-            // Beyond the outermost measured ring: the nearest measurement.
-            if let Some(nearest) = self.triangulation.nearest_neighbor(position) {
-                weights.push((nearest.fix(), 1.0));
-            }
-        }
-        let blend: Vec<(&Fitted, f64)> = weights.iter().map(|(v, w)| (self.at(self.vertex_patch[v.index()]), *w)).collect();
+        let (weights, turn) = self.lookup.find(incoming);
+        let blend: Vec<(&Fitted, f64)> = weights.iter().map(|&(i, w)| (&self.fitted[i], w)).collect();
+        let turn = DQuat::from_rotation_z(turn);
         let ranks = blend.iter().map(|(f, _)| f.lobes.len()).max().unwrap_or(0);
         let mut response = PanelResponse::default();
         for rank in 0..ranks {
@@ -382,7 +546,7 @@ impl PanelModel for BsdfModel {
                 }
             }
             if share > 0.0 && direction.length_squared() > 0.0 {
-                response.lobes.push(Lobe { direction: direction.normalize(), share, width });
+                response.lobes.push(Lobe { direction: turn * direction.normalize(), share, width });
             }
         }
         for (fitted, w) in &blend {
@@ -399,6 +563,10 @@ impl PanelModel for BsdfModel {
 
     fn back_reflectance(&self) -> f64 {
         self.back_reflectance
+    }
+
+    fn measured(&self) -> Option<&dyn MeasuredTransmission> {
+        Some(&self.data)
     }
 }
 
@@ -631,6 +799,87 @@ mod tests {
             for d in [DVec3::Z, DVec3::new(0.5, 0.2, 0.84).normalize(), DVec3::new(-0.7, -0.6, 0.39).normalize()] {
                 let r = model.response(d);
                 assert!((r.transmitted() - 0.1 * std::f64::consts::PI).abs() < 1e-6, "{structure} {d}: {}", r.transmitted());
+            }
+        }
+    }
+
+    /// A tree is constant over an incoming leaf, as Radiance reads it: where
+    /// its transmittance steps between two leaves, 1° either side of the
+    /// edge reads the one leaf or the other, not a blend. 4-D: 0.1 where
+    /// the light travels toward −x, 0.3 toward +x (the square's first axis
+    /// halved); 3-D: 0.1 within 30° of the normal, 0.3 beyond (its first
+    /// axis, ½ − ½ sin θ, halved twice).
+    #[test]
+    fn a_tree_steps_where_its_incoming_leaves_do() {
+        let uniform = |v: f64| format!("{{ {v} }}");
+        let square: String = (0..16).map(|c| uniform(if c & 1 == 0 { 0.1 } else { 0.3 })).collect();
+        let ring: String = (0..8).map(|c| uniform(if c & 1 == 0 { 0.3 } else { 0.1 })).collect();
+        let rings: String = (0..8).map(|c| if c & 1 == 0 { format!("{{ {ring} }}") } else { uniform(0.0) }).collect();
+        let around = |theta: f64, phi: f64| {
+            let (theta, phi) = (theta.to_radians(), phi.to_radians());
+            DVec3::new(phi.cos() * theta.sin(), phi.sin() * theta.sin(), theta.cos())
+        };
+        // (Where the light travels, the value it reads.)
+        type Queries = [(DVec3, f64); 4];
+        let cases: [(&str, String, Queries); 2] = [
+            (
+                "TensorTree4",
+                square,
+                [(around(1.0, 180.0), 0.1), (around(1.0, 0.0), 0.3), (around(40.0, 91.0), 0.1), (around(40.0, 89.0), 0.3)],
+            ),
+            (
+                "TensorTree3",
+                rings,
+                [(around(29.0, 17.0), 0.1), (around(31.0, 17.0), 0.3), (around(29.0, 250.0), 0.1), (around(31.0, 250.0), 0.3)],
+            ),
+        ];
+        for (structure, data, queries) in cases {
+            let file = xml::parse(&tree_file(structure, &format!("{{ {data} }}")), Path::new("step.xml")).unwrap();
+            let model = BsdfModel::fit(&file, 3, 23.0);
+            for (travel, value) in queries {
+                let expected = value * std::f64::consts::PI;
+                let got = model.response(travel).transmitted();
+                assert!((got - expected).abs() < 1e-6, "{structure} {travel}: {got} vs {expected}");
+            }
+        }
+    }
+
+    /// The measured transmission is the file's, cell by cell: a Klems
+    /// file's row for a patch holds its matrix column, each outgoing patch
+    /// found from its middle; a 4-D tree's (front, or back read by
+    /// reciprocity) is its leaf value at any pair of directions.
+    #[test]
+    fn the_measured_transmission_reads_the_file() {
+        let file = load("ven45.xml");
+        let Scattering::Klems { basis, transmission, .. } = &file.scattering else { panic!("not Klems") };
+        let model = BsdfModel::fit(&file, 3, 23.0);
+        let data = model.measured().unwrap();
+        let patches = klems_patches(basis);
+        assert_eq!(data.outgoing_cells(), patches.len());
+        for i in [0, 9, 40, 77, 120, 144] {
+            let row = data.row(patches[i].0);
+            for (o, patch) in patches.iter().enumerate() {
+                assert_eq!(row[data.outgoing_cell(patch.0)], transmission.get(i, o), "patch {i} → {o}");
+            }
+        }
+        for name in ["redirect_tt4.xml", "redirect_back_tt4.xml"] {
+            let file = load(name);
+            let Scattering::TensorTree { transmission: tree, reciprocal, .. } = &file.scattering else { panic!("{name}") };
+            let model = BsdfModel::fit(&file, 3, 23.0);
+            let data = model.measured().unwrap();
+            let mut rng = 0.37f64;
+            let mut next = || {
+                rng = (rng * 997.0 + 0.123).fract();
+                rng
+            };
+            for _ in 0..200 {
+                let hemisphere = |a: f64, b: f64| {
+                    let [x, y] = square_to_disk(a, b);
+                    DVec3::new(x, y, (1.0 - x * x - y * y).max(0.0).sqrt())
+                };
+                let (travel, out) = (hemisphere(next(), next()), hemisphere(next(), next()));
+                let held = if *reciprocal { tree.value(out, -travel) } else { tree.value(-travel, out) };
+                assert_eq!(data.row(travel)[data.outgoing_cell(out)], held, "{name} {travel} → {out}");
             }
         }
     }
