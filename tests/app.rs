@@ -146,6 +146,62 @@ fn render_smoke_test_draws_the_model() {
     assert!(levels.len() >= 4, "shades {levels:?}");
 }
 
+/// Edges are anti-aliased after tone mapping (SMAA), the sun pass left
+/// exact: against the same view drawn at 4 × 4 the resolution and
+/// averaged (a supersampled reference), the picture's pixels on edges are
+/// closer than point samples of that reference (one sub-pixel of each
+/// 4 × 4 block: an aliased picture), and the rest is left as it was.
+#[test]
+fn edges_are_smoothed_toward_a_supersampled_picture() {
+    let request = |width: u32, height: u32| OffscreenRequest {
+        scene: heliodon::bundled_scene("office"),
+        view: None,
+        width,
+        height,
+        when: Some(LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(14.0).unwrap() }),
+        sky: Some(SkySpec::Clear { turbidity: 2.45 }),
+        settings: RenderSettings { exposure: Some(10.0), ..Default::default() },
+        panels: Default::default(),
+    };
+    let (width, height, k) = (320usize, 200usize, 4usize);
+    let picture = offscreen::render(request(width as u32, height as u32)).expect("render");
+    let fine = offscreen::render(request((k * width) as u32, (k * height) as u32)).expect("render");
+    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("anti_aliased_office.png");
+    picture.save_png(&out).unwrap();
+    // Luminance in linear units, from the 8-bit sRGB pictures.
+    let linear = |c: u8| {
+        let c = f32::from(c) / 255.0;
+        if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    };
+    let luminance =
+        |rgba: &[u8], i: usize| 0.2126 * linear(rgba[4 * i]) + 0.7152 * linear(rgba[4 * i + 1]) + 0.0722 * linear(rgba[4 * i + 2]);
+    let sub = |x: usize, y: usize, dx: usize, dy: usize| luminance(&fine.rgba, (k * y + dy) * k * width + k * x + dx);
+    let (mut edges, mut aa_error, mut point_error, mut flat_error, mut flat) = (0, 0.0, 0.0, 0.0, 0);
+    for y in 0..height {
+        for x in 0..width {
+            let reference = (0..k * k).map(|s| sub(x, y, s % k, s / k)).sum::<f32>() / (k * k) as f32;
+            let point = sub(x, y, 1, 1);
+            let drawn = luminance(&picture.rgba, y * width + x);
+            if (point - reference).abs() > 0.02 {
+                edges += 1;
+                aa_error += (drawn - reference).abs();
+                point_error += (point - reference).abs();
+            } else {
+                flat += 1;
+                flat_error += (drawn - reference).abs();
+            }
+        }
+    }
+    let (aa_error, point_error, flat_error) = (aa_error / edges as f32, point_error / edges as f32, flat_error / flat as f32);
+    println!(
+        "{edges} edge pixels: anti-aliased {aa_error:.4} from the supersampled picture, point samples {point_error:.4}; elsewhere {flat_error:.4} -> {}",
+        out.display()
+    );
+    assert!(edges > 500, "the view has edges: {edges}");
+    assert!(aa_error < 0.75 * point_error, "edges: anti-aliased {aa_error} vs point samples {point_error}");
+    assert!(flat_error < 0.01, "away from edges the picture is the supersampled one: {flat_error}");
+}
+
 #[test]
 fn the_sun_and_sky_follow_the_clock_once_per_change() {
     use heliodon::ecs::{LightChanged, SkyChoice, SolarTime, SunSky};

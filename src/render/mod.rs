@@ -13,6 +13,7 @@ pub mod surfaces;
 
 use std::sync::Arc;
 
+use bevy::anti_alias::smaa::Smaa;
 use bevy::camera::Exposure;
 use bevy::camera::Hdr;
 use bevy::core_pipeline::tonemapping::Tonemapping;
@@ -107,8 +108,17 @@ impl Default for RenderSettings {
     }
 }
 
+/// A camera a person looks through: the hybrid renderer's, its edges
+/// smoothed by SMAA after tone mapping, so that the sun pass's stencil
+/// stays exact (MSAA would need a multisampled stencil and depth for it).
+pub fn picture_camera() -> impl Bundle {
+    (hybrid_camera(), Smaa::default())
+}
+
 /// A camera set up for the hybrid renderer: HDR target, no MSAA (the sun
 /// pass shares the main depth), sampleable depth, filmic tone mapping.
+/// Without anti-aliasing: a physical-units image keeps each pixel's own
+/// value.
 pub fn hybrid_camera() -> impl Bundle {
     (
         Camera3d { depth_texture_usages: (TextureUsages::RENDER_ATTACHMENT | TextureUsages::TEXTURE_BINDING).into(), ..default() },

@@ -22,7 +22,7 @@ use bevy::window::ExitCondition;
 use bevy::winit::WinitPlugin;
 
 use super::sun_pass::SunPassInput;
-use super::{HeliodonRenderPlugin, PhysicalUnits, RenderMode, RenderSettings, hybrid_camera, initial_view};
+use super::{HeliodonRenderPlugin, PhysicalUnits, RenderMode, RenderSettings, hybrid_camera, initial_view, picture_camera};
 use crate::ecs::{
     ActiveScene, HeliodonPlugins, LightingFailed, LightingPlugin, LightingState, OpenScene, RegisterPanel, SceneLoadFailed, SceneSpawned,
     SkyChoice, SolarTime, SunSky,
@@ -217,7 +217,7 @@ fn spawn_cameras(
         Projection::Perspective(PerspectiveProjection { fov: view.fov.to_radians(), ..default() }),
         Transform::from_translation(view.eye).looking_at(view.target, Vec3::Z),
     );
-    commands.spawn((hybrid_camera(), RenderTarget::Image(picture.clone().into()), placement.clone()));
+    commands.spawn((picture_camera(), RenderTarget::Image(picture.clone().into()), placement.clone()));
     commands
         .spawn((hybrid_camera(), Camera { order: 1, ..default() }, PhysicalUnits, RenderTarget::Image(physical.clone().into()), placement))
         .insert((Tonemapping::None, unit_exposure()));

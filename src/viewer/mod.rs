@@ -77,7 +77,7 @@ impl Plugin for ViewerPlugin {
             // luminance picture shows the model alone.
             gizmos.config_mut::<DefaultGizmoConfigGroup>().0.render_layers = RenderLayers::layer(OVERLAY_LAYER);
             commands.spawn((
-                crate::render::hybrid_camera(),
+                crate::render::picture_camera(),
                 CadCamera::looking(Vec3::new(-8.0, -10.0, 8.0), Vec3::ZERO),
                 RenderLayers::from_layers(&[0, OVERLAY_LAYER]),
             ));
