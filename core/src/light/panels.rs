@@ -135,16 +135,40 @@ impl LightModel {
     }
 }
 
-/// How a panel group passes sky and ground light, per sphere bin the light
-/// comes from: the bins its lobes' beams ([`spread`]) leave along, as factors from the
-/// incoming bin's radiance to the radiance seen through the panel in the
-/// outgoing bin (share · cos θin · ωin / (cos θout · ωout)), and the factor
-/// to the radiance of its diffuse transmission (τd · cos θin · ωin / π).
-pub struct SkyTransfer {
-    /// Per incoming bin: (outgoing bin, radiance factor) for each transmitted lobe.
-    pub lobes: Vec<Vec<(u32, f64)>>,
-    /// Per incoming bin: the factor to the diffusely transmitted radiance.
-    pub diffuse: Vec<f64>,
+/// How a panel group passes sky and ground light into the radiance seen
+/// through it in each sphere bin.
+pub enum SkyTransfer {
+    /// By the model's response, per sphere bin the light comes from: the
+    /// bins its lobes' beams ([`spread`]) leave along, as factors from the
+    /// incoming bin's radiance to the radiance seen through the panel in
+    /// the outgoing bin (share · cos θin · ωin / (cos θout · ωout)), and the
+    /// factor to the radiance of its diffuse transmission (τd · cos θin ·
+    /// ωin / π).
+    Lobes {
+        /// Per incoming bin: (outgoing bin, radiance factor) for each transmitted lobe.
+        lobes: Vec<Vec<(u32, f64)>>,
+        /// Per incoming bin: the factor to the diffusely transmitted radiance.
+        diffuse: Vec<f64>,
+    },
+    /// By the model's measured transmission ([`PanelModel::measured`]),
+    /// as Radiance's 3-phase method does: the light of the incoming bins
+    /// summed per incoming patch of the data (a Klems basis), its
+    /// irradiance then sent into every outgoing bin by the data's BTDF
+    /// from that patch. No lobe fit between the data and the room: a
+    /// diffusing panel's light goes where the data sends it, not evenly.
+    Measured {
+        /// Per incoming bin: its patch and the factor cos θin · ωin from its
+        /// radiance to the patch's irradiance (patch `u32::MAX`: the bin
+        /// lies on the room's side).
+        incoming: Vec<(u32, f64)>,
+        /// The bins the light leaves into the room along (the others see
+        /// none of it).
+        outgoing: Vec<u32>,
+        /// The BTDF from each patch into each of those bins, `[bin][patch]`.
+        btdf: Vec<f32>,
+        /// The data's incoming patches.
+        patches: usize,
+    },
 }
 
 impl PanelGroup {
@@ -164,6 +188,26 @@ impl PanelGroup {
                 if b < bins.len() { d } else { DVec3::new(d.x, d.y, -d.z) }
             };
             let solid_angle = |b: usize| bins.patches[b % bins.len()].solid_angle;
+            if let Some(data) = self.model.measured() {
+                let incoming = (0..count)
+                    .map(|b| {
+                        let travel = self.frame.to_panel(-direction(b));
+                        if travel.z > 0.0 { (data.incoming_patch(travel) as u32, travel.z * solid_angle(b)) } else { (u32::MAX, 0.0) }
+                    })
+                    .collect();
+                let patches = data.incoming_patches();
+                let rows = super::par_map(None, patches, |p| data.patch_row(p));
+                // Seen from the room along bin o, the light leaves against it.
+                let leaving = |o: u32| self.frame.to_panel(-direction(o as usize));
+                let outgoing: Vec<u32> = (0..count as u32).filter(|&o| leaving(o).z > 0.0).collect();
+                let btdf = (outgoing.iter())
+                    .flat_map(|&o| {
+                        let cell = data.outgoing_cell(leaving(o));
+                        rows.iter().map(move |row| row.get(cell).map_or(0.0, |&f| f as f32))
+                    })
+                    .collect();
+                return SkyTransfer::Measured { incoming, outgoing, btdf, patches };
+            }
             // Each bin on its own (panel responses can be costly): in parallel.
             let per_bin = super::par_map(None, count, |b| {
                 // Light from bin b travels away from it.
@@ -187,7 +231,7 @@ impl PanelGroup {
                 (lobes, response.diffuse_transmittance * flux / std::f64::consts::PI)
             });
             let (lobes, diffuse) = per_bin.into_iter().unzip();
-            SkyTransfer { lobes, diffuse }
+            SkyTransfer::Lobes { lobes, diffuse }
         })
     }
 
@@ -195,21 +239,34 @@ impl PanelGroup {
     /// windows in every sphere bin, for bin radiances `sky` (each as much as
     /// the windows see of it: [`Outlook`]).
     pub fn radiance_through(&self, bins: &SkyPatches, sky: &[f64]) -> Vec<f64> {
-        let transfer = self.sky_transfer(bins);
-        let mut out = vec![0.0; sky.len()];
-        let mut diffuse = 0.0;
-        for (b, &radiance) in sky.iter().enumerate() {
-            let radiance = radiance * self.outlook.sky_seen.get(b).copied().unwrap_or(1.0);
-            if radiance <= 0.0 {
-                continue;
+        let seen = sky.iter().enumerate().map(|(b, &radiance)| radiance * self.outlook.sky_seen.get(b).copied().unwrap_or(1.0));
+        match self.sky_transfer(bins) {
+            SkyTransfer::Lobes { lobes, diffuse: diffuse_factors } => {
+                let mut out = vec![0.0; sky.len()];
+                let mut diffuse = 0.0;
+                for (b, radiance) in seen.enumerate().filter(|(_, r)| *r > 0.0) {
+                    for &(o, factor) in &lobes[b] {
+                        out[o as usize] += factor * radiance;
+                    }
+                    diffuse += diffuse_factors[b] * radiance;
+                }
+                out.iter_mut().for_each(|r| *r += diffuse);
+                out
             }
-            for &(o, factor) in &transfer.lobes[b] {
-                out[o as usize] += factor * radiance;
+            SkyTransfer::Measured { incoming, outgoing, btdf, patches } => {
+                let mut irradiance = vec![0.0; *patches];
+                for ((patch, factor), radiance) in incoming.iter().zip(seen) {
+                    if let Some(e) = irradiance.get_mut(*patch as usize) {
+                        *e += factor * radiance;
+                    }
+                }
+                let mut out = vec![0.0; sky.len()];
+                for (&o, row) in outgoing.iter().zip(btdf.chunks_exact(*patches)) {
+                    out[o as usize] = row.iter().zip(&irradiance).map(|(&f, e)| f64::from(f) * e).sum();
+                }
+                out
             }
-            diffuse += transfer.diffuse[b] * radiance;
         }
-        out.iter_mut().for_each(|r| *r += diffuse);
-        out
     }
 
     /// Radiance (W/sr/m²) of the sunlight the group's windows transmit
@@ -328,6 +385,8 @@ pub fn sun_beams(groups: &[PanelGroup], sun: &SunSource) -> Vec<SunBeam> {
 
 #[cfg(test)]
 mod tests {
+    use std::f64::consts::PI;
+
     use super::*;
 
     /// A wide lobe's beams carry its share, centred on it, spread as light
@@ -351,6 +410,97 @@ mod tests {
         let grazing = spread(&Lobe { direction: DVec3::new(0.0, 0.999, 0.045).normalize(), share: 0.3, width: 30.0 });
         assert!(grazing.len() < 3 && grazing.iter().all(|b| b.0.z > 0.0));
         assert!((grazing.iter().map(|b| b.1).sum::<f64>() - 0.3).abs() < 1e-12);
+    }
+
+    /// Measured transmission on the patches of a Tregenza sky laid on the
+    /// panel (incoming patches and outgoing cells alike): a diffuser
+    /// (BTDF τ/π everywhere) or clear glass at patch resolution (BTDF
+    /// τ / projected solid angle from a patch into the same patch).
+    #[derive(Debug)]
+    struct OnPatches {
+        patches: SkyPatches,
+        diffuser: bool,
+    }
+
+    impl crate::panel::MeasuredTransmission for OnPatches {
+        fn outgoing_cells(&self) -> usize {
+            self.patches.len()
+        }
+        fn outgoing_cell(&self, outgoing: DVec3) -> usize {
+            self.patches.patch_of(outgoing).unwrap_or(0)
+        }
+        fn row(&self, incoming: DVec3) -> Vec<f64> {
+            self.patch_row(self.incoming_patch(incoming))
+        }
+        fn incoming_patches(&self) -> usize {
+            self.patches.len()
+        }
+        fn incoming_patch(&self, incoming: DVec3) -> usize {
+            self.patches.patch_of(incoming).unwrap_or(0)
+        }
+        fn patch_row(&self, patch: usize) -> Vec<f64> {
+            let projected = self.patches.patches[patch].projected_solid_angle;
+            (0..self.patches.len())
+                .map(|o| {
+                    if self.diffuser {
+                        0.4 / PI
+                    } else if o == patch {
+                        0.4 / projected
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        }
+    }
+
+    impl PanelModel for OnPatches {
+        fn response(&self, _: DVec3) -> crate::panel::PanelResponse {
+            crate::panel::PanelResponse { diffuse_transmittance: 0.4, absorbed: 0.6, ..Default::default() }
+        }
+        fn measured(&self) -> Option<&dyn crate::panel::MeasuredTransmission> {
+            Some(self)
+        }
+    }
+
+    fn group(model: OnPatches) -> PanelGroup {
+        PanelGroup {
+            material: 0,
+            model: Arc::new(model),
+            // A south window: into the room is north.
+            frame: PanelFrame::new(DVec3::Y, None),
+            back_reflectance: 0.0,
+            outlook: Outlook::default(),
+            transfer: OnceLock::new(),
+        }
+    }
+
+    /// Sky light passes a panel with measured data by the data: a diffuser
+    /// of τ = 0.4 under an even sphere of radiance 1 shows 0.4 in every
+    /// direction seen from the room; clear glass at patch resolution shows
+    /// one bright sky bin where one looks toward it through the window, and
+    /// nowhere else.
+    #[test]
+    fn sky_light_passes_a_measured_panel_by_its_data() {
+        let bins = SkyPatches::reinhart(4);
+        let panel = |diffuser| group(OnPatches { patches: SkyPatches::reinhart(1), diffuser });
+        let room_side = |b: usize| {
+            let d = bins.patches[b % bins.len()].direction;
+            let d = if b < bins.len() { d } else { DVec3::new(d.x, d.y, -d.z) };
+            (d.y < -0.05).then_some(d)
+        };
+        let seen = panel(true).radiance_through(&bins, &vec![1.0; 2 * bins.len()]);
+        for (b, radiance) in seen.iter().enumerate().filter(|(b, _)| room_side(*b).is_some()) {
+            assert!((radiance - 0.4).abs() < 0.004, "bin {b}: {radiance}");
+        }
+        let bright = bins.sphere_bin(DVec3::new(0.3, -0.8, 0.5).normalize());
+        let mut sky = vec![0.0; 2 * bins.len()];
+        sky[bright] = 1.0;
+        let seen = panel(false).radiance_through(&bins, &sky);
+        let brightest = (0..seen.len()).max_by(|&a, &b| seen[a].total_cmp(&seen[b])).unwrap();
+        let patch = |b: usize| SkyPatches::reinhart(1).patch_of(PanelFrame::new(DVec3::Y, None).to_panel(-room_side(b).unwrap()));
+        assert_eq!(patch(brightest), patch(bright), "seen in bin {brightest}, the bright bin is {bright}");
+        assert!(seen[bright] > 0.0 && seen.iter().enumerate().all(|(b, &r)| r == 0.0 || patch(b) == patch(bright)));
     }
 
     #[test]

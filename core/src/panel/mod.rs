@@ -107,6 +107,16 @@ pub trait MeasuredTransmission: Send + Sync {
     /// The BTDF into every outgoing cell for light travelling along
     /// `incoming` (unit, panel frame, z > 0).
     fn row(&self, incoming: DVec3) -> Vec<f64>;
+    /// Patches of incoming directions the data's rows hold for (a Klems
+    /// basis: sky light is gathered per patch, as Radiance's 3-phase method
+    /// does).
+    fn incoming_patches(&self) -> usize;
+    /// The incoming patch (below [`Self::incoming_patches`]) holding
+    /// `incoming` (unit, panel frame, z > 0).
+    fn incoming_patch(&self, incoming: DVec3) -> usize;
+    /// The BTDF into every outgoing cell for light arriving over incoming
+    /// patch `patch`, averaged over it.
+    fn patch_row(&self, patch: usize) -> Vec<f64>;
 }
 
 /// A kind of panel, registered by name: builds models from scene-file keys.

@@ -310,12 +310,42 @@ fn tree_incoming(dims: usize, cells: usize) -> Vec<DVec3> {
 /// leaves, up to this, keeps them within a cell's width.
 const TREE_CELLS: usize = 64;
 
+/// The Klems full basis (θ from, θ to in degrees, patches around): the
+/// incoming patches a tree's light is gathered in, as `bsdf2klems` and
+/// Radiance's 3-phase method take them.
+const KLEMS_FULL: [(f64, f64, usize); 9] = [
+    (0.0, 5.0, 1),
+    (5.0, 15.0, 8),
+    (15.0, 25.0, 16),
+    (25.0, 35.0, 20),
+    (35.0, 45.0, 24),
+    (45.0, 55.0, 24),
+    (55.0, 65.0, 24),
+    (65.0, 75.0, 16),
+    (75.0, 90.0, 12),
+];
+
+/// Incoming directions per axis of a Klems patch a tree's row is averaged over.
+const PATCH_SAMPLES: usize = 4;
+
+/// Klems patches: per ring, θ from, θ to (radians) and its first patch and count.
+type KlemsRings = Vec<(f64, f64, usize, usize)>;
+
+fn klems_rings(rings: impl Iterator<Item = (f64, f64, usize)>) -> KlemsRings {
+    let mut start = 0;
+    rings
+        .map(|(low, high, phis)| {
+            start += phis;
+            (low.to_radians(), high.to_radians(), start - phis, phis)
+        })
+        .collect()
+}
+
 /// A file's transmission from outside into the room, looked up as
 /// Radiance does: the Klems patch or tree leaf holding the directions.
 enum Transmission {
     Klems {
-        /// Per ring: θ from, θ to (radians) and its first patch and count.
-        rings: Vec<(f64, f64, usize, usize)>,
+        rings: KlemsRings,
         matrix: xml::Matrix,
     },
     Tree {
@@ -324,29 +354,34 @@ enum Transmission {
         reciprocal: bool,
         /// Outgoing cells per axis of the square.
         cells: usize,
+        /// The Klems full basis, for [`MeasuredTransmission::patch_row`].
+        rings: KlemsRings,
     },
 }
 
 impl Transmission {
     fn of(file: &BsdfFile) -> Self {
         match &file.scattering {
-            Scattering::Klems { basis, transmission, .. } => {
-                let mut start = 0;
-                let rings = basis
-                    .rings
-                    .iter()
-                    .map(|r| {
-                        start += r.phis;
-                        (r.theta_low.to_radians(), r.theta_high.to_radians(), start - r.phis, r.phis)
-                    })
-                    .collect();
-                Self::Klems { rings, matrix: transmission.clone() }
-            }
+            Scattering::Klems { basis, transmission, .. } => Self::Klems {
+                rings: klems_rings(basis.rings.iter().map(|r| (r.theta_low, r.theta_high, r.phis))),
+                matrix: transmission.clone(),
+            },
             Scattering::TensorTree { transmission, reciprocal, .. } => {
                 let finest = (1.0 / transmission.smallest_leaf()).round() as usize;
                 let cells = if transmission.dims() == 4 { finest.min(TREE_CELLS) } else { (2 * finest).min(TREE_CELLS) };
-                Self::Tree { tree: transmission.clone(), reciprocal: *reciprocal, cells: cells.max(1) }
+                Self::Tree {
+                    tree: transmission.clone(),
+                    reciprocal: *reciprocal,
+                    cells: cells.max(1),
+                    rings: klems_rings(KLEMS_FULL.into_iter()),
+                }
             }
+        }
+    }
+
+    fn rings(&self) -> &KlemsRings {
+        match self {
+            Self::Klems { rings, .. } | Self::Tree { rings, .. } => rings,
         }
     }
 
@@ -368,6 +403,40 @@ impl MeasuredTransmission for Transmission {
         }
     }
 
+    fn incoming_patches(&self) -> usize {
+        self.rings().last().map_or(0, |r| r.2 + r.3)
+    }
+
+    fn incoming_patch(&self, incoming: DVec3) -> usize {
+        Self::patch(self.rings(), incoming)
+    }
+
+    fn patch_row(&self, patch: usize) -> Vec<f64> {
+        let rings = self.rings();
+        let Some(&(low, high, start, count)) = rings.iter().find(|r| patch < r.2 + r.3) else { return vec![0.0; self.outgoing_cells()] };
+        match self {
+            Self::Klems { matrix, .. } => (0..self.outgoing_cells()).map(|o| matrix.get(patch, o).max(0.0)).collect(),
+            Self::Tree { .. } => {
+                // The mean over the patch, its directions spread evenly in
+                // projected solid angle (cos²θ) and φ.
+                let mut sum = vec![0.0; self.outgoing_cells()];
+                let width = std::f64::consts::TAU / count as f64;
+                let middle = width * (patch - start) as f64;
+                for k in 0..PATCH_SAMPLES * PATCH_SAMPLES {
+                    let (a, b) = (
+                        ((k / PATCH_SAMPLES) as f64 + 0.5) / PATCH_SAMPLES as f64,
+                        ((k % PATCH_SAMPLES) as f64 + 0.5) / PATCH_SAMPLES as f64,
+                    );
+                    let cos2 = low.cos().powi(2) + a * (high.cos().powi(2) - low.cos().powi(2));
+                    let (sin, phi) = ((1.0 - cos2).max(0.0).sqrt(), middle + width * (b - 0.5));
+                    let row = self.row(DVec3::new(sin * phi.cos(), sin * phi.sin(), cos2.sqrt()));
+                    sum.iter_mut().zip(row).for_each(|(s, f)| *s += f / (PATCH_SAMPLES * PATCH_SAMPLES) as f64);
+                }
+                sum
+            }
+        }
+    }
+
     fn outgoing_cell(&self, outgoing: DVec3) -> usize {
         match self {
             Self::Klems { rings, .. } => Self::patch(rings, outgoing),
@@ -385,7 +454,7 @@ impl MeasuredTransmission for Transmission {
                 let patch = Self::patch(rings, incoming);
                 (0..matrix.values.len() / matrix.incoming).map(|o| matrix.get(patch, o)).collect::<Vec<f64>>()
             }
-            Self::Tree { tree, reciprocal, cells } => (0..cells * cells)
+            Self::Tree { tree, reciprocal, cells, .. } => (0..cells * cells)
                 .map(|k| {
                     let out = cell_direction(k, *cells, 1.0);
                     if *reciprocal { tree.value(out, -incoming) } else { tree.value(-incoming, out) }
