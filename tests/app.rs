@@ -202,6 +202,52 @@ fn edges_are_smoothed_toward_a_supersampled_picture() {
     assert!(flat_error < 0.01, "away from edges the picture is the supersampled one: {flat_error}");
 }
 
+/// The sky around the model is the sky model's luminance: looking up
+/// from beside the office at a clear March afternoon, every pixel of the
+/// physical image holds the sky's luminance in its direction (Perez here;
+/// the cubemap's 2.8° texels blended, the sun's own disc not drawn).
+#[test]
+fn the_sky_drawn_around_the_model_is_the_sky_model() {
+    let scene_path = heliodon::bundled_scene("office");
+    let scene = load_scene(&scene_path, &PanelCatalog::new()).unwrap().scene;
+    let when = LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(14.0).unwrap() };
+    let spec = SkySpec::Clear { turbidity: 2.45 };
+    let sky = heliodon::sky::sky_at(&scene.site, &spec, &when).1.unwrap();
+    // Away from the building, looking north-east and up, away from the sun.
+    let view = Viewpoint { name: "up".into(), eye: Vec3::new(-60.0, -60.0, 2.0), target: Vec3::new(-55.0, -50.0, 9.0), fov: 50.0 };
+    let (width, height) = (160usize, 100usize);
+    let request = OffscreenRequest {
+        scene: scene_path,
+        view: Some(view.clone()),
+        width: width as u32,
+        height: height as u32,
+        when: Some(when),
+        sky: Some(spec),
+        settings: RenderSettings { exposure: Some(12.0), ..Default::default() },
+        panels: Default::default(),
+    };
+    let image = offscreen::render(request).expect("render");
+    let forward = (view.target - view.eye).normalize().as_dvec3();
+    let right = forward.cross(heliodon::glam::DVec3::Z).normalize();
+    let up = right.cross(forward);
+    let tan = (0.5 * f64::from(view.fov)).to_radians().tan();
+    let mut errors: Vec<f64> = (0..width * height)
+        .map(|k| {
+            let (x, y) = ((k % width) as f64, (k / width) as f64);
+            let along_x = (2.0 * (x + 0.5) / width as f64 - 1.0) * tan * width as f64 / height as f64;
+            let along_y = (1.0 - 2.0 * (y + 0.5) / height as f64) * tan;
+            let direction = (forward + right * along_x + up * along_y).normalize();
+            let expected = sky.radiance(direction) * heliodon::sky::LUMINOUS_EFFICACY;
+            let drawn = heliodon::light::luminous(image.physical[k].map(f64::from));
+            (drawn / expected - 1.0).abs()
+        })
+        .collect();
+    errors.sort_by(f64::total_cmp);
+    let (median, worst) = (errors[errors.len() / 2], errors[errors.len() - 1]);
+    println!("sky pixels against the sky model: median {:.2}%, worst {:.2}%", 100.0 * median, 100.0 * worst);
+    assert!(median < 0.005 && worst < 0.02, "median {median}, worst {worst}");
+}
+
 #[test]
 fn the_sun_and_sky_follow_the_clock_once_per_change() {
     use heliodon::ecs::{LightChanged, SkyChoice, SolarTime, SunSky};

@@ -2,12 +2,14 @@
 //! 3.3 and 3.5). Surfaces show the light engine's sky and interreflected
 //! light per patch ([`surfaces`]); direct sun is drawn per pixel every frame
 //! by stencil shadow volumes ([`sun_pass`]); Bevy's HDR target, exposure and
-//! filmic tone mapping turn the physical values (cd/m²) into a picture.
+//! filmic tone mapping turn the physical values (cd/m²) into a picture; the
+//! sky model's luminance is drawn around the model ([`sky`]).
 //! Also the initial view of a scene and offscreen rendering ([`offscreen`]).
 
 pub mod legend;
 pub mod offscreen;
 pub mod reference;
+pub mod sky;
 pub mod sun_pass;
 pub mod surfaces;
 
@@ -56,7 +58,7 @@ impl Plugin for HeliodonRenderPlugin {
                     .chain()
                     .after(HeliodonSystems::Lighting),
             )
-            .add_plugins((SurfaceLightingPlugin, SunPassPlugin))
+            .add_plugins((SurfaceLightingPlugin, SunPassPlugin, sky::SkyBackgroundPlugin))
             .add_systems(Update, update_sun_pass.in_set(HeliodonRenderSystems::SunPass))
             .add_systems(Update, (auto_exposure, tone_mapping_for_mode).in_set(HeliodonRenderSystems::Exposure));
     }

@@ -108,7 +108,8 @@ impl Material for LightingMaterial {
     }
 }
 
-/// Glass as a faint blue-grey, panels amber: readable at any exposure.
+/// Glass as a faint blue-grey (its alpha is its opacity, 1 − τ), panels
+/// amber: readable at any exposure.
 const GLASS_TINT: LinearRgba = LinearRgba::new(0.35, 0.45, 0.55, 0.18);
 const PANEL_TINT: LinearRgba = LinearRgba::new(0.7, 0.5, 0.2, 0.3);
 
@@ -136,7 +137,8 @@ fn spawn_surface_meshes(
         let Some((mesh, values)) = material_mesh(scene, index as u32) else { continue };
         let tint = match &material.kind {
             MaterialKind::Diffuse { .. } => LinearRgba::BLACK,
-            MaterialKind::Glass { .. } => GLASS_TINT,
+            // What lies beyond shows through by the glass's transmittance.
+            MaterialKind::Glass { transmittance } => LinearRgba { alpha: (1.0 - transmittance).clamp(0.02, 1.0), ..GLASS_TINT },
             MaterialKind::Panel { .. } => PANEL_TINT,
         };
         let lighting = |underlay| LightingMaterial { tint, mode: settings.mode, scale_max_lux: settings.false_colour_max_lux, underlay };
