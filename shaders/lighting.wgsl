@@ -15,6 +15,8 @@ struct LightingMaterial {
     mode: u32,
     // Illuminance at the top of the false-colour scale, lux.
     scale_max_lux: f32,
+    // Fragments above this height (model z) are cut away from the eye.
+    section: f32,
 }
 
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var<uniform> material: LightingMaterial;
@@ -35,6 +37,9 @@ fn false_colour(lux: f32, top: f32) -> vec3<f32> {
 
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
+    if in.world_position.z > material.section {
+        discard;
+    }
 #ifdef VERTEX_COLORS
     let value = in.color.rgb;
 #else

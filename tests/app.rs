@@ -248,6 +248,52 @@ fn the_sky_drawn_around_the_model_is_the_sky_model() {
     assert!(median < 0.005 && worst < 0.02, "median {median}, worst {worst}");
 }
 
+/// A horizontal section shows the rooms from above: looking straight down
+/// on the office at noon, the sunlit roof fills the middle of the picture;
+/// cut under the ceiling, the floor and desks inside show instead (under
+/// an eighth of the roof's luminance), with the sun that the windows and
+/// skylights let in on them (the sun pass still sees the whole model).
+#[test]
+fn a_section_shows_the_rooms_from_above() {
+    let view = Viewpoint { name: "plan".into(), eye: Vec3::new(5.3, 7.0, 40.0), target: Vec3::new(5.3, 7.01, 0.0), fov: 12.0 };
+    let render = |section: Option<f32>| {
+        let request = OffscreenRequest {
+            scene: heliodon::bundled_scene("office"),
+            view: Some(view.clone()),
+            width: 120,
+            height: 120,
+            when: Some(LocalDateTime { date: Date::new(2026, 6, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() }),
+            sky: Some(SkySpec::Clear { turbidity: 2.45 }),
+            settings: RenderSettings { section, ..Default::default() },
+            panels: Default::default(),
+        };
+        offscreen::render(request).expect("render")
+    };
+    // The middle 60 × 60 pixels lie inside the building's outline.
+    let middle = |image: &offscreen::RenderedImage| -> Vec<f64> {
+        let mut values: Vec<f64> = (30..90)
+            .flat_map(|y| (30..90).map(move |x| y * 120 + x))
+            .map(|k| heliodon::light::luminous(image.physical[k].map(f64::from)))
+            .collect();
+        values.sort_by(f64::total_cmp);
+        values
+    };
+    let roof = middle(&render(None));
+    let cut = render(Some(2.7));
+    cut.save_png(&PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("office_plan_section.png")).unwrap();
+    let inside = middle(&cut);
+    let median = |v: &[f64]| v[v.len() / 2];
+    println!(
+        "median luminance: roof {:.0} cd/m², under the section {:.0}; brightest inside {:.0}",
+        median(&roof),
+        median(&inside),
+        inside[inside.len() - 1]
+    );
+    assert!(median(&inside) < median(&roof) / 8.0, "roof {} vs inside {}", median(&roof), median(&inside));
+    assert!(median(&inside) > 1.0, "the rooms are lit: {}", median(&inside));
+    assert!(inside[inside.len() - 1] > 5.0 * median(&inside), "sun patches inside: {}", inside[inside.len() - 1]);
+}
+
 #[test]
 fn the_sun_and_sky_follow_the_clock_once_per_change() {
     use heliodon::ecs::{LightChanged, SkyChoice, SolarTime, SunSky};

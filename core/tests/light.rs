@@ -721,3 +721,19 @@ fn annual_hours_read_what_sensors_reads_within_2_percent() {
         assert!(errors[errors.len() / 2] < 0.003, "{name}: median {}", errors[errors.len() / 2]);
     }
 }
+
+/// A plan's section cuts just under the ceiling of the storey the camera is
+/// in: from inside the office and from high above it (the storey of the
+/// automatic interior view), 0.3 m under the ceiling over the room.
+#[test]
+fn a_plan_section_cuts_under_the_ceiling_of_the_storey() {
+    let scene = load(&heliodon_core::bundled_scene("office"));
+    let model = LightModel::unlit(scene);
+    let inside = glam::Vec3::new(5.0, 7.0, 1.5);
+    let (_, up) = model.trace(inside.as_dvec3(), glam::DVec3::Z).expect("the office has a ceiling");
+    let ceiling = inside.z + up as f32;
+    for eye in [inside, glam::Vec3::new(5.0, 7.0, 40.0)] {
+        let section = model.storey_section(eye).expect("a storey");
+        assert!((section - (ceiling - 0.3)).abs() < 1e-3, "{eye}: {section} under a ceiling at {ceiling}");
+    }
+}

@@ -102,11 +102,16 @@ pub struct RenderSettings {
     pub exposure: Option<f32>,
     /// Top of the false-colour scale, lux (the scale spans three decades).
     pub false_colour_max_lux: f32,
+    /// A horizontal section: what lies above this height (model z, metres)
+    /// is hidden from the eye, so that one looks into the rooms from above.
+    /// The light still comes from the whole model (the sun pass's volumes
+    /// are every surface's).
+    pub section: Option<f32>,
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { mode: RenderMode::Full, exposure: None, false_colour_max_lux: 10_000.0 }
+        Self { mode: RenderMode::Full, exposure: None, false_colour_max_lux: 10_000.0, section: None }
     }
 }
 
@@ -245,7 +250,9 @@ fn auto_exposure(
                 .map(|sun| MIDDLE_GREY / std::f64::consts::PI * sun.normal_irradiance() * crate::sky::LUMINOUS_EFFICACY)
         } else {
             match (&active.scene, state.as_ref().and_then(|s| s.lighting.as_ref()), engine.as_ref().and_then(|e| e.model.as_ref())) {
-                (Some(scene), Some(lighting), Some(model)) => metered_luminance(scene, model, &lighting.sides, &transform, projection),
+                (Some(scene), Some(lighting), Some(model)) => {
+                    metered_luminance(scene, model, &lighting.sides, &transform, projection, settings.section)
+                }
                 _ => None,
             }
         };
@@ -261,14 +268,17 @@ const MIDDLE_GREY: f64 = 0.18;
 const METERED_PATCHES: usize = 4096;
 
 /// Log-average luminance (cd/m²) of the diffuse patch sides a camera sees
-/// (facing it, inside its view cone, not hidden), weighted by solid angle.
+/// (facing it, inside its view cone, not hidden; under the `section`, which
+/// hides what lies above it), weighted by solid angle.
 fn metered_luminance(
     scene: &Scene,
     model: &LightModel,
     sides: &[Channels],
     camera: &GlobalTransform,
     projection: &Projection,
+    section: Option<f32>,
 ) -> Option<f64> {
+    let cut = f64::from(section.unwrap_or(f32::MAX));
     let eye = camera.translation().as_dvec3();
     let forward = camera.forward().as_vec3().as_dvec3();
     let Projection::Perspective(perspective) = projection else { return None };
@@ -285,10 +295,10 @@ fn metered_luminance(
         let direction = to_patch / distance;
         let back = direction.dot(patch.normal.as_dvec3()) > 0.0;
         let cos_view = direction.dot(patch.normal.as_dvec3()).abs();
-        if direction.dot(forward) < cos_cone || cos_view < 1e-3 {
+        if direction.dot(forward) < cos_cone || cos_view < 1e-3 || patch.centroid.z as f64 > cut {
             continue;
         }
-        if model.trace(eye, direction).is_some_and(|(hit, t)| hit as usize != p && t < distance - 1e-3) {
+        if hidden(model, eye, direction, distance, p, cut) {
             continue;
         }
         let channels = sides.get(side_of(p as u32, back) as usize)?;
@@ -302,6 +312,24 @@ fn metered_luminance(
         }
     }
     (weight > 0.0).then(|| (sum / weight).exp())
+}
+
+/// Whether something below the `cut` height lies between `eye` and patch
+/// `patch`, `distance` away along `direction` (what the section hides is
+/// passed through).
+fn hidden(model: &LightModel, eye: crate::glam::DVec3, direction: crate::glam::DVec3, distance: f64, patch: usize, cut: f64) -> bool {
+    let mut travelled = 0.0;
+    while let Some((hit, t)) = model.trace(eye + direction * travelled, direction) {
+        let t = travelled + t;
+        if hit as usize == patch || t >= distance - 1e-3 {
+            return false;
+        }
+        if (eye + direction * t).z <= cut {
+            return true;
+        }
+        travelled = t + 1e-4;
+    }
+    false
 }
 
 /// The view a scene opens on: its first `[[cameras]]` entry, else a view

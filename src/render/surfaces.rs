@@ -46,6 +46,8 @@ pub struct LightingMaterial {
     pub tint: LinearRgba,
     pub mode: RenderMode,
     pub scale_max_lux: f32,
+    /// Fragments above this height are not drawn ([`RenderSettings::section`]).
+    pub section: f32,
     /// Drawn behind the patch meshes, filling their cracks.
     pub underlay: bool,
 }
@@ -67,6 +69,7 @@ pub struct LightingMaterialUniform {
     tint: Vec4,
     mode: u32,
     scale_max_lux: f32,
+    section: f32,
 }
 
 impl bevy::render::render_resource::AsBindGroupShaderType<LightingMaterialUniform> for LightingMaterial {
@@ -78,6 +81,7 @@ impl bevy::render::render_resource::AsBindGroupShaderType<LightingMaterialUnifor
             tint: self.tint.to_vec4(),
             mode: u32::from(self.mode == RenderMode::FalseColour),
             scale_max_lux: self.scale_max_lux,
+            section: self.section,
         }
     }
 }
@@ -141,7 +145,13 @@ fn spawn_surface_meshes(
             MaterialKind::Glass { transmittance } => LinearRgba { alpha: (1.0 - transmittance).clamp(0.02, 1.0), ..GLASS_TINT },
             MaterialKind::Panel { .. } => PANEL_TINT,
         };
-        let lighting = |underlay| LightingMaterial { tint, mode: settings.mode, scale_max_lux: settings.false_colour_max_lux, underlay };
+        let lighting = |underlay| LightingMaterial {
+            tint,
+            mode: settings.mode,
+            scale_max_lux: settings.false_colour_max_lux,
+            section: section_height(&settings),
+            underlay,
+        };
         let mut entity = commands.spawn((Mesh3d(meshes.add(mesh)), MeshMaterial3d(materials.add(lighting(false))), ChildOf(*root)));
         if let MaterialKind::Diffuse { reflectance } = &material.kind {
             entity.insert(SurfaceValues { reflectance: reflectance.0, ..values });
@@ -247,6 +257,11 @@ pub fn side_value(channels: &Channels, reflectance: [f32; 3], mode: RenderMode) 
     }
 }
 
+/// The height above which surfaces are not drawn (none: out of reach).
+fn section_height(settings: &RenderSettings) -> f32 {
+    settings.section.unwrap_or(f32::MAX)
+}
+
 fn update_surface_values(
     state: Option<Res<LightingState>>,
     settings: Res<RenderSettings>,
@@ -264,6 +279,7 @@ fn update_surface_values(
         {
             material.mode = settings.mode;
             material.scale_max_lux = settings.false_colour_max_lux;
+            material.section = section_height(&settings);
         }
         let (Some(values), Some(lighting)) = (values, state.as_ref().and_then(|s| s.lighting.as_ref())) else { continue };
         let node_values: Vec<[f32; 3]> = values

@@ -103,4 +103,27 @@ impl super::LightModel {
         let target = glam::Vec3::new(centre.x, centre.y, floor + 1.0);
         Some(crate::scene::Viewpoint { name: "inside".into(), eye, target, fov: crate::scene::DEFAULT_FOV })
     }
+
+    /// The height of a plan's horizontal section for a camera at `eye`:
+    /// just under the ceiling of the storey the eye is in (the first
+    /// surface straight above it), else, from outside, of the storey of the
+    /// automatic interior view ([`Self::interior_view`]), else of the
+    /// model's lowest point under its middle. `None` with no ceiling found.
+    pub fn storey_section(&self, eye: glam::Vec3) -> Option<f32> {
+        let ceiling_above = |from: glam::Vec3| self.trace(from.as_dvec3(), DVec3::Z).map(|(_, d)| from.z + d as f32);
+        let (lo, hi) = self
+            .scene
+            .patches
+            .patches
+            .iter()
+            .fold((glam::Vec3::MAX, glam::Vec3::MIN), |(lo, hi), p| (lo.min(p.centroid), hi.max(p.centroid)));
+        let inside = ceiling_above(eye).filter(|&c| c < hi.z + 1e-3 && self.trace(eye.as_dvec3(), -DVec3::Z).is_some());
+        let ceiling = inside
+            .or_else(|| self.interior_view().and_then(|v| ceiling_above(v.eye)))
+            .or_else(|| ceiling_above(glam::Vec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), lo.z + 0.1)))?;
+        Some(ceiling - SECTION_BELOW_CEILING)
+    }
 }
+
+/// How far under a ceiling a plan's section cuts, m.
+const SECTION_BELOW_CEILING: f32 = 0.3;

@@ -41,6 +41,9 @@ pub struct RenderArgs {
     /// full, sun, sky, indirect or falsecolor
     #[arg(long, default_value = "full", value_parser = parse_mode)]
     pub mode: RenderMode,
+    /// A horizontal section: hide what lies above this height (model metres) to look into the rooms; the light still comes from the whole model
+    #[arg(long, value_name = "Z", value_parser = in_range(-1e5, 1e5))]
+    pub section: Option<f64>,
 }
 
 fn parse_mode(text: &str) -> Result<RenderMode, String> {
@@ -78,7 +81,12 @@ pub fn run(args: &RenderArgs, panels: &PanelCatalog) -> Result<(), CliError> {
         height: args.height,
         when: Some(case.when()),
         sky: Some(sky),
-        settings: RenderSettings { mode: args.mode, exposure: args.exposure.map(|e| e as f32), ..Default::default() },
+        settings: RenderSettings {
+            mode: args.mode,
+            exposure: args.exposure.map(|e| e as f32),
+            section: args.section.map(|z| z as f32),
+            ..Default::default()
+        },
         panels: panels.clone(),
     })?;
     image.save_png(&args.out)?;

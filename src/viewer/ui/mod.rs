@@ -119,7 +119,7 @@ fn panels(
             egui::ScrollArea::vertical().show(ui, |ui| {
                 camera::camera_panel(ui, &mut camera_control, &sensors.active);
                 ui.separator();
-                view.show(ui, &mut settings, &mut note.0);
+                view.show(ui, &mut settings, &mut camera_control, &mut note.0);
                 ui.separator();
                 annual.show(ui, &mut note.0, sun_and_sky.site());
                 ui.separator();

@@ -1,5 +1,6 @@
-//! The view panel: the render mode (with the false-colour scale), the
-//! light's progress, the frame time, and saving the view.
+//! The view panel: the render mode (with the false-colour scale), a
+//! horizontal section and the plan view, the light's progress, the frame
+//! time, and saving the view.
 
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
@@ -7,6 +8,7 @@ use bevy_egui::egui::{self, Ui};
 
 use crate::ecs::{LightEngine, LightingState};
 use crate::render::{RenderMode, RenderSettings};
+use crate::viewer::camera::{CadCamera, CameraControl, CameraRequest};
 use crate::viewer::capture::{ImageFormat, SaveRequest};
 use crate::viewer::redraw::DrawnFrameTimes;
 use crate::viewer::widgets::bounded;
@@ -14,20 +16,61 @@ use crate::viewer::widgets::bounded;
 /// What the view panel reads and writes (the render settings come from the
 /// caller: the sun and sky panel sets their exposure).
 #[derive(SystemParam)]
-pub struct ViewPanel<'w> {
+pub struct ViewPanel<'w, 's> {
     lighting: Option<Res<'w, LightingState>>,
     engine: Option<Res<'w, LightEngine>>,
     frame_times: Res<'w, DrawnFrameTimes>,
     save: ResMut<'w, SaveRequest>,
+    eyes: Query<'w, 's, &'static GlobalTransform, With<CadCamera>>,
 }
 
-impl ViewPanel<'_> {
-    /// Draws the panel.
-    pub fn show(&mut self, ui: &mut Ui, settings: &mut ResMut<RenderSettings>, note: &mut Option<String>) {
+impl ViewPanel<'_, '_> {
+    /// Draws the panel; the plan view asks `camera` to look down.
+    pub fn show(&mut self, ui: &mut Ui, settings: &mut ResMut<RenderSettings>, camera: &mut CameraControl, note: &mut Option<String>) {
         // Frame time while drawing, and the worst of the recent history (ms).
         let frame_time = self.frame_times.mean_and_worst();
         view_panel(ui, note, &mut self.save, settings, self.lighting.as_deref(), self.engine.as_deref(), frame_time);
+        // Where a section cuts by default: under the ceiling of the camera's storey.
+        let storey = || {
+            let model = self.engine.as_ref()?.model.clone()?;
+            model.storey_section(self.eyes.iter().next()?.translation())
+        };
+        section_row(ui, settings, camera, storey, note);
     }
+}
+
+/// The horizontal section (on, and its height) and the plan view: looking
+/// down on the section with the light in false colour, as daylighting
+/// reports show it.
+fn section_row(
+    ui: &mut Ui,
+    settings: &mut ResMut<RenderSettings>,
+    camera: &mut CameraControl,
+    storey: impl Fn() -> Option<f32>,
+    note: &mut Option<String>,
+) {
+    ui.horizontal(|ui| {
+        let mut on = settings.section.is_some();
+        if ui
+            .checkbox(&mut on, "section at")
+            .on_hover_text("hide what lies above this height to look into the rooms; the light still comes from the whole model")
+            .changed()
+        {
+            settings.section = on.then(|| storey().unwrap_or(2.5));
+        }
+        if let Some(height) = settings.section {
+            let mut value = height;
+            bounded(ui, &mut value, -1000.0..=10_000.0, 0.05, "", " m", note);
+            if value != height {
+                settings.section = Some(value);
+            }
+        }
+        if ui.button("Plan").on_hover_text("look down on the section, the light in false colour (lux)").clicked() {
+            settings.section = settings.section.or_else(&storey).or(Some(2.5));
+            settings.mode = RenderMode::FalseColour;
+            camera.request = Some(CameraRequest::Top);
+        }
+    });
 }
 
 fn view_panel(
