@@ -17,7 +17,15 @@ struct LightingMaterial {
     scale_max_lux: f32,
     // Fragments above this height (model z) are cut away from the eye.
     section: f32,
+    // A vertical section: fragments with dot(normal, p) > offset are cut
+    // away (xy: the horizontal normal, w: the offset; a zero normal: none).
+    vertical_section: vec4<f32>,
 }
+
+// Surfaces within this distance of a section are drawn in the cut colour:
+// a line where the section cuts them, so the cut reads as one.
+const CUT_LINE: f32 = 0.03;
+const CUT_COLOUR: vec4<f32> = vec4(0.55, 0.08, 0.06, 1.0);
 
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var<uniform> material: LightingMaterial;
 
@@ -37,8 +45,13 @@ fn false_colour(lux: f32, top: f32) -> vec3<f32> {
 
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
-    if in.world_position.z > material.section {
+    let beyond = dot(material.vertical_section.xy, in.world_position.xy) - material.vertical_section.w;
+    let has_vertical = dot(material.vertical_section.xy, material.vertical_section.xy) > 0.0;
+    if in.world_position.z > material.section || (has_vertical && beyond > 0.0) {
         discard;
+    }
+    if in.world_position.z > material.section - CUT_LINE || (has_vertical && beyond > -CUT_LINE) {
+        return CUT_COLOUR;
     }
 #ifdef VERTEX_COLORS
     let value = in.color.rgb;

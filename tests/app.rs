@@ -248,6 +248,32 @@ fn the_sky_drawn_around_the_model_is_the_sky_model() {
     assert!(median < 0.005 && worst < 0.02, "median {median}, worst {worst}");
 }
 
+/// The office drawn at 120 × 120 from `view` at (year, month, day, hour)
+/// under a clear sky.
+fn office_picture(view: &Viewpoint, (year, month, day, hour): (i32, u32, u32, f64), settings: RenderSettings) -> offscreen::RenderedImage {
+    let request = OffscreenRequest {
+        scene: heliodon::bundled_scene("office"),
+        view: Some(view.clone()),
+        width: 120,
+        height: 120,
+        when: Some(LocalDateTime { date: Date::new(year, month, day).unwrap(), time: TimeOfDay::from_hours(hour).unwrap() }),
+        sky: Some(SkySpec::Clear { turbidity: 2.45 }),
+        settings,
+        panels: Default::default(),
+    };
+    offscreen::render(request).expect("render")
+}
+
+/// The luminances (cd/m², sorted) of the middle 60 × 60 pixels of a 120 × 120 picture.
+fn middle_luminances(image: &offscreen::RenderedImage) -> Vec<f64> {
+    let mut values: Vec<f64> = (30..90)
+        .flat_map(|y| (30..90).map(move |x| y * 120 + x))
+        .map(|k| heliodon::light::luminous(image.physical[k].map(f64::from)))
+        .collect();
+    values.sort_by(f64::total_cmp);
+    values
+}
+
 /// A horizontal section shows the rooms from above: looking straight down
 /// on the office at noon, the sunlit roof fills the middle of the picture;
 /// cut under the ceiling, the floor and desks inside show instead (under
@@ -256,32 +282,11 @@ fn the_sky_drawn_around_the_model_is_the_sky_model() {
 #[test]
 fn a_section_shows_the_rooms_from_above() {
     let view = Viewpoint { name: "plan".into(), eye: Vec3::new(5.3, 7.0, 40.0), target: Vec3::new(5.3, 7.01, 0.0), fov: 12.0 };
-    let render = |section: Option<f32>| {
-        let request = OffscreenRequest {
-            scene: heliodon::bundled_scene("office"),
-            view: Some(view.clone()),
-            width: 120,
-            height: 120,
-            when: Some(LocalDateTime { date: Date::new(2026, 6, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() }),
-            sky: Some(SkySpec::Clear { turbidity: 2.45 }),
-            settings: RenderSettings { section, ..Default::default() },
-            panels: Default::default(),
-        };
-        offscreen::render(request).expect("render")
-    };
-    // The middle 60 × 60 pixels lie inside the building's outline.
-    let middle = |image: &offscreen::RenderedImage| -> Vec<f64> {
-        let mut values: Vec<f64> = (30..90)
-            .flat_map(|y| (30..90).map(move |x| y * 120 + x))
-            .map(|k| heliodon::light::luminous(image.physical[k].map(f64::from)))
-            .collect();
-        values.sort_by(f64::total_cmp);
-        values
-    };
-    let roof = middle(&render(None));
+    let render = |section: Option<f32>| office_picture(&view, (2026, 6, 21, 12.0), RenderSettings { section, ..Default::default() });
+    let roof = middle_luminances(&render(None));
     let cut = render(Some(2.7));
     cut.save_png(&PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("office_plan_section.png")).unwrap();
-    let inside = middle(&cut);
+    let inside = middle_luminances(&cut);
     let median = |v: &[f64]| v[v.len() / 2];
     println!(
         "median luminance: roof {:.0} cd/m², under the section {:.0}; brightest inside {:.0}",
@@ -292,6 +297,23 @@ fn a_section_shows_the_rooms_from_above() {
     assert!(median(&inside) < median(&roof) / 8.0, "roof {} vs inside {}", median(&roof), median(&inside));
     assert!(median(&inside) > 1.0, "the rooms are lit: {}", median(&inside));
     assert!(inside[inside.len() - 1] > 5.0 * median(&inside), "sun patches inside: {}", inside[inside.len() - 1]);
+}
+
+/// A vertical section opens the building to a side view: from the south at
+/// a March afternoon the sunlit south wall fills the middle of the
+/// picture; with the southern 4.3 m cut away, the rooms behind it show
+/// instead, darker than the sunlit wall by far.
+#[test]
+fn a_vertical_section_opens_the_side_of_the_building() {
+    let view = Viewpoint { name: "south".into(), eye: Vec3::new(5.3, -30.0, 1.5), target: Vec3::new(5.3, 7.0, 1.5), fov: 6.0 };
+    let render = |vertical_section| office_picture(&view, (2026, 3, 21, 14.0), RenderSettings { vertical_section, ..Default::default() });
+    let median = |values: Vec<f64>| values[values.len() / 2];
+    let wall = median(middle_luminances(&render(None)));
+    let image = render(Some(heliodon::render::VerticalSection { azimuth: 180.0, offset: -4.3 }));
+    image.save_png(&PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("office_vertical_section.png")).unwrap();
+    let inside = median(middle_luminances(&image));
+    println!("median luminance: the south wall {wall:.0} cd/m², behind the section {inside:.0}");
+    assert!(inside < wall / 4.0 && inside > 1.0, "wall {wall} vs inside {inside}");
 }
 
 #[test]

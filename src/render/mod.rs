@@ -107,11 +107,45 @@ pub struct RenderSettings {
     /// The light still comes from the whole model (the sun pass's volumes
     /// are every surface's).
     pub section: Option<f32>,
+    /// A vertical section, hiding one side of a vertical plane as
+    /// `section` hides what lies above.
+    pub vertical_section: Option<VerticalSection>,
+}
+
+/// A vertical section plane: what lies beyond it, toward `azimuth`, is
+/// hidden from the eye.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VerticalSection {
+    /// The way the hidden side lies, degrees clockwise from the model's
+    /// north (+y).
+    pub azimuth: f32,
+    /// Where the plane stands along that way from the model's origin, m.
+    pub offset: f32,
+}
+
+impl RenderSettings {
+    /// Whether a section hides point `p` (model metres) from the eye.
+    pub fn cuts_away(&self, p: crate::glam::DVec3) -> bool {
+        let above = self.section.is_some_and(|z| p.z > f64::from(z));
+        let beyond = self.vertical_section.is_some_and(|v| {
+            let plane = v.plane().as_dvec4();
+            plane.x * p.x + plane.y * p.y > plane.w
+        });
+        above || beyond
+    }
+}
+
+impl VerticalSection {
+    /// The plane's horizontal normal toward the hidden side, and its offset.
+    pub fn plane(&self) -> Vec4 {
+        let (sin, cos) = self.azimuth.to_radians().sin_cos();
+        Vec4::new(sin, cos, 0.0, self.offset)
+    }
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { mode: RenderMode::Full, exposure: None, false_colour_max_lux: 10_000.0, section: None }
+        Self { mode: RenderMode::Full, exposure: None, false_colour_max_lux: 10_000.0, section: None, vertical_section: None }
     }
 }
 
@@ -251,7 +285,7 @@ fn auto_exposure(
         } else {
             match (&active.scene, state.as_ref().and_then(|s| s.lighting.as_ref()), engine.as_ref().and_then(|e| e.model.as_ref())) {
                 (Some(scene), Some(lighting), Some(model)) => {
-                    metered_luminance(scene, model, &lighting.sides, &transform, projection, settings.section)
+                    metered_luminance(scene, model, &lighting.sides, &transform, projection, &|p| settings.cuts_away(p))
                 }
                 _ => None,
             }
@@ -268,17 +302,16 @@ const MIDDLE_GREY: f64 = 0.18;
 const METERED_PATCHES: usize = 4096;
 
 /// Log-average luminance (cd/m²) of the diffuse patch sides a camera sees
-/// (facing it, inside its view cone, not hidden; under the `section`, which
-/// hides what lies above it), weighted by solid angle.
+/// (facing it, inside its view cone, not hidden; not `cut` away by a
+/// section, and seen past what is), weighted by solid angle.
 fn metered_luminance(
     scene: &Scene,
     model: &LightModel,
     sides: &[Channels],
     camera: &GlobalTransform,
     projection: &Projection,
-    section: Option<f32>,
+    cut: &dyn Fn(crate::glam::DVec3) -> bool,
 ) -> Option<f64> {
-    let cut = f64::from(section.unwrap_or(f32::MAX));
     let eye = camera.translation().as_dvec3();
     let forward = camera.forward().as_vec3().as_dvec3();
     let Projection::Perspective(perspective) = projection else { return None };
@@ -295,7 +328,7 @@ fn metered_luminance(
         let direction = to_patch / distance;
         let back = direction.dot(patch.normal.as_dvec3()) > 0.0;
         let cos_view = direction.dot(patch.normal.as_dvec3()).abs();
-        if direction.dot(forward) < cos_cone || cos_view < 1e-3 || patch.centroid.z as f64 > cut {
+        if direction.dot(forward) < cos_cone || cos_view < 1e-3 || cut(patch.centroid.as_dvec3()) {
             continue;
         }
         if hidden(model, eye, direction, distance, p, cut) {
@@ -314,17 +347,24 @@ fn metered_luminance(
     (weight > 0.0).then(|| (sum / weight).exp())
 }
 
-/// Whether something below the `cut` height lies between `eye` and patch
-/// `patch`, `distance` away along `direction` (what the section hides is
-/// passed through).
-fn hidden(model: &LightModel, eye: crate::glam::DVec3, direction: crate::glam::DVec3, distance: f64, patch: usize, cut: f64) -> bool {
+/// Whether something not `cut` away lies between `eye` and patch `patch`,
+/// `distance` away along `direction` (what a section hides is passed
+/// through).
+fn hidden(
+    model: &LightModel,
+    eye: crate::glam::DVec3,
+    direction: crate::glam::DVec3,
+    distance: f64,
+    patch: usize,
+    cut: &dyn Fn(crate::glam::DVec3) -> bool,
+) -> bool {
     let mut travelled = 0.0;
     while let Some((hit, t)) = model.trace(eye + direction * travelled, direction) {
         let t = travelled + t;
         if hit as usize == patch || t >= distance - 1e-3 {
             return false;
         }
-        if (eye + direction * t).z <= cut {
+        if !cut(eye + direction * t) {
             return true;
         }
         travelled = t + 1e-4;
@@ -357,4 +397,28 @@ pub fn framing((lo, hi): (Vec3, Vec3), fov_degrees: f32) -> (Vec3, f32) {
     let centre = (lo + hi) / 2.0;
     let radius = ((hi - lo).length() / 2.0).max(0.1);
     (centre, 1.1 * radius / (fov_degrees.to_radians() / 2.0).sin())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::glam::DVec3;
+
+    /// A section hides what lies above it; a vertical one what lies beyond
+    /// its plane toward its azimuth (south here: y under 4 m).
+    #[test]
+    fn sections_cut_away_above_and_beyond() {
+        let settings = RenderSettings {
+            section: Some(2.9),
+            vertical_section: Some(VerticalSection { azimuth: 180.0, offset: -4.0 }),
+            ..Default::default()
+        };
+        assert!(!settings.cuts_away(DVec3::new(1.0, 5.0, 1.0)));
+        assert!(settings.cuts_away(DVec3::new(1.0, 5.0, 3.0)));
+        assert!(settings.cuts_away(DVec3::new(1.0, 3.0, 1.0)));
+        assert!(!RenderSettings::default().cuts_away(DVec3::new(1.0, 3.0, 100.0)));
+        // East: x over 2 m hidden.
+        let east = RenderSettings { vertical_section: Some(VerticalSection { azimuth: 90.0, offset: 2.0 }), ..Default::default() };
+        assert!(east.cuts_away(DVec3::new(2.5, 0.0, 0.0)) && !east.cuts_away(DVec3::new(1.5, 0.0, 0.0)));
+    }
 }

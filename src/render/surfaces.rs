@@ -48,6 +48,9 @@ pub struct LightingMaterial {
     pub scale_max_lux: f32,
     /// Fragments above this height are not drawn ([`RenderSettings::section`]).
     pub section: f32,
+    /// Fragments beyond this vertical plane (normal x, y, 0, offset) are not
+    /// drawn ([`RenderSettings::vertical_section`]; a zero normal: none).
+    pub vertical_section: Vec4,
     /// Drawn behind the patch meshes, filling their cracks.
     pub underlay: bool,
 }
@@ -70,6 +73,7 @@ pub struct LightingMaterialUniform {
     mode: u32,
     scale_max_lux: f32,
     section: f32,
+    vertical_section: Vec4,
 }
 
 impl bevy::render::render_resource::AsBindGroupShaderType<LightingMaterialUniform> for LightingMaterial {
@@ -82,6 +86,7 @@ impl bevy::render::render_resource::AsBindGroupShaderType<LightingMaterialUnifor
             mode: u32::from(self.mode == RenderMode::FalseColour),
             scale_max_lux: self.scale_max_lux,
             section: self.section,
+            vertical_section: self.vertical_section,
         }
     }
 }
@@ -150,6 +155,7 @@ fn spawn_surface_meshes(
             mode: settings.mode,
             scale_max_lux: settings.false_colour_max_lux,
             section: section_height(&settings),
+            vertical_section: vertical_plane(&settings),
             underlay,
         };
         let mut entity = commands.spawn((Mesh3d(meshes.add(mesh)), MeshMaterial3d(materials.add(lighting(false))), ChildOf(*root)));
@@ -262,6 +268,11 @@ fn section_height(settings: &RenderSettings) -> f32 {
     settings.section.unwrap_or(f32::MAX)
 }
 
+/// The vertical section's plane (none: a zero normal, nothing is beyond it).
+fn vertical_plane(settings: &RenderSettings) -> Vec4 {
+    settings.vertical_section.map_or(Vec4::ZERO, |v| v.plane())
+}
+
 fn update_surface_values(
     state: Option<Res<LightingState>>,
     settings: Res<RenderSettings>,
@@ -280,6 +291,7 @@ fn update_surface_values(
             material.mode = settings.mode;
             material.scale_max_lux = settings.false_colour_max_lux;
             material.section = section_height(&settings);
+            material.vertical_section = vertical_plane(&settings);
         }
         let (Some(values), Some(lighting)) = (values, state.as_ref().and_then(|s| s.lighting.as_ref())) else { continue };
         let node_values: Vec<[f32; 3]> = values

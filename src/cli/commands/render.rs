@@ -6,7 +6,7 @@ use crate::cli::CliError;
 use crate::cli::args::{SceneCase, in_range, load_for_command, parse_point};
 use crate::panel::PanelCatalog;
 use crate::render::offscreen::OffscreenRequest;
-use crate::render::{RenderMode, RenderSettings};
+use crate::render::{RenderMode, RenderSettings, VerticalSection};
 use crate::scene::{DEFAULT_FOV, Viewpoint};
 
 #[derive(clap::Args, Debug)]
@@ -44,6 +44,15 @@ pub struct RenderArgs {
     /// A horizontal section: hide what lies above this height (model metres) to look into the rooms; the light still comes from the whole model
     #[arg(long, value_name = "Z", value_parser = in_range(-1e5, 1e5))]
     pub section: Option<f64>,
+    /// A vertical section: hide what lies beyond a vertical plane, toward DEG (clockwise from north), M metres from the model's origin that way
+    #[arg(long, value_name = "DEG,M", value_parser = parse_vertical_section)]
+    pub vertical_section: Option<VerticalSection>,
+}
+
+fn parse_vertical_section(text: &str) -> Result<VerticalSection, String> {
+    let parts: Vec<&str> = text.split(',').collect();
+    let [azimuth, offset] = parts[..] else { return Err(format!("'{text}' is not DEG,M")) };
+    Ok(VerticalSection { azimuth: in_range(-360.0, 360.0)(azimuth)? as f32, offset: in_range(-1e5, 1e5)(offset)? as f32 })
 }
 
 fn parse_mode(text: &str) -> Result<RenderMode, String> {
@@ -85,6 +94,7 @@ pub fn run(args: &RenderArgs, panels: &PanelCatalog) -> Result<(), CliError> {
             mode: args.mode,
             exposure: args.exposure.map(|e| e as f32),
             section: args.section.map(|z| z as f32),
+            vertical_section: args.vertical_section,
             ..Default::default()
         },
         panels: panels.clone(),

@@ -7,7 +7,7 @@ use bevy::prelude::*;
 use bevy_egui::egui::{self, Ui};
 
 use crate::ecs::{LightEngine, LightingState};
-use crate::render::{RenderMode, RenderSettings};
+use crate::render::{RenderMode, RenderSettings, VerticalSection};
 use crate::viewer::camera::{CadCamera, CameraControl, CameraRequest};
 use crate::viewer::capture::{ImageFormat, SaveRequest};
 use crate::viewer::redraw::DrawnFrameTimes;
@@ -31,12 +31,44 @@ impl ViewPanel<'_, '_> {
         let frame_time = self.frame_times.mean_and_worst();
         view_panel(ui, note, &mut self.save, settings, self.lighting.as_deref(), self.engine.as_deref(), frame_time);
         // Where a section cuts by default: under the ceiling of the camera's storey.
-        let storey = || {
-            let model = self.engine.as_ref()?.model.clone()?;
-            model.storey_section(self.eyes.iter().next()?.translation())
-        };
+        let eye = self.eyes.iter().next().map(GlobalTransform::translation);
+        let model = self.engine.as_ref().and_then(|e| e.model.clone());
+        let storey = || model.as_ref()?.storey_section(eye?);
         section_row(ui, settings, camera, storey, note);
+        // A vertical one by default through the model's middle, hiding the half toward the camera.
+        let across = || {
+            let scene = &model.as_ref()?.scene;
+            let count = scene.patches.patches.len().max(1) as f32;
+            let middle = scene.patches.patches.iter().map(|p| p.centroid).sum::<Vec3>() / count;
+            let toward = (eye? - middle).truncate();
+            let azimuth = toward.x.atan2(toward.y).to_degrees().rem_euclid(360.0);
+            Some(VerticalSection { azimuth, offset: VerticalSection { azimuth, offset: 0.0 }.plane().truncate().dot(middle) })
+        };
+        vertical_section_row(ui, settings, across, note);
     }
+}
+
+/// The vertical section: on, the way its hidden side lies and where it stands.
+fn vertical_section_row(
+    ui: &mut Ui,
+    settings: &mut ResMut<RenderSettings>,
+    across: impl Fn() -> Option<VerticalSection>,
+    note: &mut Option<String>,
+) {
+    ui.horizontal(|ui| {
+        let mut on = settings.vertical_section.is_some();
+        if ui.checkbox(&mut on, "vertical section").on_hover_text("hide what lies beyond a vertical plane").changed() {
+            settings.vertical_section = on.then(|| across().unwrap_or(VerticalSection { azimuth: 180.0, offset: 0.0 }));
+        }
+        if let Some(section) = settings.vertical_section {
+            let mut edited = section;
+            bounded(ui, &mut edited.azimuth, 0.0..=360.0, 1.0, "toward ", "°", note);
+            bounded(ui, &mut edited.offset, -10_000.0..=10_000.0, 0.05, "at ", " m", note);
+            if edited != section {
+                settings.vertical_section = Some(edited);
+            }
+        }
+    });
 }
 
 /// The horizontal section (on, and its height) and the plan view: looking
