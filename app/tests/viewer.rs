@@ -178,3 +178,35 @@ fn an_idle_viewer_rests() {
     println!("viewer CPU ticks per 2 s: {samples}");
     assert!(out.status.success(), "the viewer never rested; CPU ticks per 2 s: {samples}\n{}", String::from_utf8_lossy(&out.stderr));
 }
+
+/// `view --plan` opens on the plan: looking down on a section under the
+/// office's ceiling, in false colour. The rooms' floor (hundreds to a few
+/// thousand lux: orange and yellow on the scale) fills the view where the
+/// roof in the sun (over the scale's top: white) would otherwise be.
+#[test]
+fn the_viewer_opens_on_the_plan() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viewer_plan");
+    std::fs::create_dir_all(&dir).unwrap();
+    let shot = dir.join("office_plan.png");
+    let _ = std::fs::remove_file(&shot);
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes/office/scene.toml");
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1280x800x24", env!("CARGO_BIN_EXE_heliodon"), "view"])
+        .arg(&scene)
+        .args(["--date", "2026-03-21", "--time", "14:00", "--plan", "--screenshot"])
+        .arg(&shot)
+        .env("HELIODON_CACHE_DIR", dir.join("cache"))
+        .output()
+        .expect("xvfb-run (tools/system-deps installs it)");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    println!("wrote {}", shot.display());
+    let image = image::open(&shot).expect("the screenshot").to_rgb8();
+    // The 3D view between the panels, around the model's middle.
+    let pixels: Vec<[u8; 3]> =
+        (480..800).step_by(4).flat_map(|x| (250..550).step_by(4).map(move |y| (x, y))).map(|(x, y)| image.get_pixel(x, y).0).collect();
+    let warm = pixels.iter().filter(|p| p[0] > 180 && p[2] < 120 && p[0] > p[2] + 100).count();
+    let white = pixels.iter().filter(|p| p.iter().all(|&c| c > 235)).count();
+    println!("plan: {warm} orange-yellow and {white} white pixels of {}", pixels.len());
+    assert!(warm > pixels.len() / 2, "the floor's light in false colour: {warm} of {}", pixels.len());
+    assert!(white < pixels.len() / 4, "not the roof over the scale's top: {white} of {}", pixels.len());
+}

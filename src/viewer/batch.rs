@@ -20,7 +20,11 @@ impl Plugin for BatchPlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(Startup, apply_view_start).add_systems(
             Update,
-            (select_start_sensor.after(HeliodonSystems::SpawnScene), take_screenshot.after(HeliodonSystems::Lighting)),
+            (
+                select_start_sensor.after(HeliodonSystems::SpawnScene),
+                start_on_plan.after(HeliodonSystems::Lighting),
+                take_screenshot.after(HeliodonSystems::Lighting),
+            ),
         );
     }
 }
@@ -42,6 +46,8 @@ pub struct ViewStart {
     pub weather: Option<PathBuf>,
     /// Run the year at once (and wait for it before saving).
     pub annual: bool,
+    /// Open on the plan view once the light model is there.
+    pub plan: bool,
 }
 
 fn apply_view_start(
@@ -102,6 +108,27 @@ fn select_start_sensor(
             exit.write(AppExit::error());
         }
     }
+}
+
+/// Turns to the plan view (`view --plan`) once the scene's light model is
+/// there: the section under the ceiling of the storey the first view is
+/// in, false colour, the top view.
+fn start_on_plan(
+    request: Option<Res<ViewStart>>,
+    engine: Res<crate::ecs::LightEngine>,
+    eyes: Query<&GlobalTransform, With<crate::viewer::camera::CadCamera>>,
+    mut settings: ResMut<crate::render::RenderSettings>,
+    mut camera: ResMut<crate::viewer::camera::CameraControl>,
+    mut done: Local<bool>,
+) {
+    if *done || !request.is_some_and(|r| r.plan) {
+        return;
+    }
+    let (Some(model), Some(eye)) = (&engine.model, eyes.iter().next()) else { return };
+    *done = true;
+    settings.section = model.storey_section(eye.translation()).or(Some(2.5));
+    settings.mode = crate::render::RenderMode::FalseColour;
+    camera.request = Some(crate::viewer::camera::CameraRequest::Top);
 }
 
 /// Frames drawn after the light converges before the window is saved.

@@ -118,11 +118,14 @@ pub fn update_year_map(inputs: PlotInputs, mut year: ResMut<YearMap>) {
     });
 }
 
-/// Sensor markers: a small cross and, over it, its total lux.
+/// Sensor markers: a small cross and, over it, its total lux; in false
+/// colour (the plan view) a disc in the colour of its lux as well, so a
+/// grid reads as the surfaces around it do.
 pub fn draw_markers(
     mut gizmos: Gizmos,
     active: Res<crate::ecs::ActiveScene>,
     selected: Res<SelectedSensor>,
+    settings: Res<crate::render::RenderSettings>,
     mut contexts: bevy_egui::EguiContexts,
     lighting: Option<Res<LightingState>>,
     camera: Query<(&Camera, &GlobalTransform), crate::render::PictureCamera>,
@@ -133,9 +136,15 @@ pub fn draw_markers(
     let readings = lighting.as_ref().and_then(|l| l.lighting.as_ref()).map(|l| &l.sensors);
     for (i, sensor) in scene.sensors.iter().enumerate() {
         let chosen = selected.0 == Some(i);
-        let colour = if chosen { Color::srgb(1.0, 0.3, 0.2) } else { Color::srgb(0.2, 0.8, 1.0) };
+        let mut colour = if chosen { Color::srgb(1.0, 0.3, 0.2) } else { Color::srgb(0.2, 0.8, 1.0) };
         let size = if chosen { 0.12 } else { 0.06 };
         let p = sensor.position;
+        if let (crate::render::RenderMode::FalseColour, Some(reading)) = (settings.mode, readings.and_then(|r| r.get(i))) {
+            let [r, g, b] = crate::render::false_colour(reading.total as f32, settings.false_colour_max_lux);
+            let disc = Isometry3d::new(p, Quat::from_rotation_arc(Vec3::Z, sensor.normal.normalize_or(Vec3::Z)));
+            gizmos.circle(disc, 2.0 * size, Color::srgb(r, g, b));
+            colour = if chosen { colour } else { Color::srgb(r, g, b) };
+        }
         gizmos.line(p - Vec3::X * size, p + Vec3::X * size, colour);
         gizmos.line(p - Vec3::Y * size, p + Vec3::Y * size, colour);
         gizmos.line(p, p + sensor.normal * size * 2.0, colour);

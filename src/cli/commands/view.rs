@@ -39,6 +39,9 @@ pub struct ViewArgs {
     /// With --weather: run the year at once, colour the sensors by DA300 (and, with --screenshot, wait for it and print sDA and ASE)
     #[arg(long, requires = "weather")]
     pub annual: bool,
+    /// Open on the plan view: a section just under the ceiling of the storey in view, looked down on, the light in false colour (lux)
+    #[arg(long)]
+    pub plan: bool,
 }
 
 /// Opens the viewer on `scene` (the bundled office when none).
@@ -62,5 +65,6 @@ fn view_request(args: &ViewArgs) -> Result<crate::viewer::ViewStart, String> {
         sky,
         weather: args.weather.clone(),
         annual: args.annual,
+        plan: args.plan,
     })
 }
