@@ -6,8 +6,23 @@
 #[path = "../../tests/support/epw.rs"]
 mod epw;
 
+use std::ffi::OsStr;
 use std::path::Path;
-use std::process::Command;
+use std::process::{Command, Output};
+
+/// `heliodon view SCENE ARGS…` in a 1280 × 800 Xvfb screen, its light
+/// cache in `dir`; it must succeed.
+fn view<'a>(scene: &Path, args: impl IntoIterator<Item = &'a OsStr>, dir: &Path) -> Output {
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1280x800x24", env!("CARGO_BIN_EXE_heliodon"), "view"])
+        .arg(scene)
+        .args(args)
+        .env("HELIODON_CACHE_DIR", dir.join("cache"))
+        .output()
+        .expect("xvfb-run (tools/system-deps installs it)");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    out
+}
 
 #[test]
 fn view_screenshot_shows_the_panels_and_the_lit_model() {
@@ -18,17 +33,8 @@ fn view_screenshot_shows_the_panels_and_the_lit_model() {
     let _ = std::fs::remove_file(&shot);
     let _ = std::fs::remove_file(&hdr);
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes/test_room/scene.toml");
-    let out = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1280x800x24", env!("CARGO_BIN_EXE_heliodon"), "view"])
-        .arg(&scene)
-        .args(["--date", "2026-03-21", "--time", "10:00", "--sensor", "near-window", "--screenshot"])
-        .arg(&shot)
-        .arg("--hdr")
-        .arg(&hdr)
-        .env("HELIODON_CACHE_DIR", dir.join("cache"))
-        .output()
-        .expect("xvfb-run (tools/system-deps installs it)");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let args = ["--date", "2026-03-21", "--time", "10:00", "--sensor", "near-window", "--screenshot"];
+    view(&scene, args.iter().map(OsStr::new).chain([shot.as_os_str(), OsStr::new("--hdr"), hdr.as_os_str()]), &dir);
     println!("wrote {}", shot.display());
     let image = image::open(&shot).expect("the screenshot").to_rgb8();
     assert_eq!(image.dimensions(), (1280, 800));
@@ -106,17 +112,9 @@ fn the_viewer_runs_the_year_of_a_weather_file() {
     let shot = dir.join("annual.png");
     let _ = std::fs::remove_file(&shot);
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes/test_room/scene.toml");
-    let out = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1280x800x24", env!("CARGO_BIN_EXE_heliodon"), "view"])
-        .arg(&scene)
-        .args(["--date", "2026-03-21", "--time", "10:30", "--weather"])
-        .arg(&epw)
-        .args(["--annual", "--screenshot"])
-        .arg(&shot)
-        .env("HELIODON_CACHE_DIR", dir.join("cache"))
-        .output()
-        .expect("xvfb-run (tools/system-deps installs it)");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let args = ["--date", "2026-03-21", "--time", "10:30", "--weather"].map(OsStr::new);
+    let out =
+        view(&scene, args.into_iter().chain([epw.as_os_str(), OsStr::new("--annual"), OsStr::new("--screenshot"), shot.as_os_str()]), &dir);
     let said = String::from_utf8_lossy(&out.stdout);
     let annual = Command::new(env!("CARGO_BIN_EXE_heliodon"))
         .arg("annual")
@@ -190,15 +188,8 @@ fn the_viewer_opens_on_the_plan() {
     let shot = dir.join("office_plan.png");
     let _ = std::fs::remove_file(&shot);
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes/office/scene.toml");
-    let out = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1280x800x24", env!("CARGO_BIN_EXE_heliodon"), "view"])
-        .arg(&scene)
-        .args(["--date", "2026-03-21", "--time", "14:00", "--plan", "--screenshot"])
-        .arg(&shot)
-        .env("HELIODON_CACHE_DIR", dir.join("cache"))
-        .output()
-        .expect("xvfb-run (tools/system-deps installs it)");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let args = ["--date", "2026-03-21", "--time", "14:00", "--plan", "--screenshot"].map(OsStr::new);
+    view(&scene, args.into_iter().chain([shot.as_os_str()]), &dir);
     println!("wrote {}", shot.display());
     let image = image::open(&shot).expect("the screenshot").to_rgb8();
     // The 3D view between the panels, around the model's middle.
