@@ -1,6 +1,9 @@
 //! Bevy apps: the simulation plugins headless (no window, no GPU), and a
 //! render smoke test on whatever Vulkan device there is (Mesa's lavapipe in CI).
 
+#[path = "support/quick_light.rs"]
+mod quick_light;
+
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -19,6 +22,7 @@ use heliodon::scene::{Viewpoint, load_scene};
 use heliodon::sky::{Sky, SkySpec};
 use heliodon::sun::solar_position;
 use heliodon::time::{Date, LocalDateTime, TimeOfDay};
+use quick_light::quick_light;
 
 fn headless_app() -> App {
     let mut app = App::new();
@@ -372,17 +376,8 @@ fn the_sun_and_sky_follow_the_clock_once_per_change() {
 /// scene `name` open.
 fn lit_app(name: &str) -> App {
     use heliodon::ecs::{self, LightCacheDir};
-    use heliodon::light::LightSettings;
     let mut app = headless_app();
-    let settings = LightSettings {
-        rays_per_patch: 64,
-        rays_per_sensor: 512,
-        sky_rays_per_sensor: 512,
-        sun_samples_per_patch: 4,
-        area_sensor_sun_grid: 4,
-        ..Default::default()
-    };
-    app.insert_resource(ecs::LightSettings(settings)).insert_resource(LightCacheDir(None));
+    app.insert_resource(ecs::LightSettings(quick_light())).insert_resource(LightCacheDir(None));
     open(&mut app, heliodon::bundled_scene(name)).unwrap();
     app
 }

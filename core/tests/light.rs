@@ -4,6 +4,8 @@
 
 #[path = "../../tests/support/quad_obj.rs"]
 mod quad_obj;
+#[path = "../../tests/support/quick_light.rs"]
+mod quick_light;
 #[path = "../../tests/support/room_on_ground.rs"]
 mod room_on_ground;
 
@@ -16,6 +18,7 @@ use heliodon_core::panel::PanelCatalog;
 use heliodon_core::scene::{Scene, load_scene};
 use heliodon_core::sky::{Sky, SkySpec, integrate_hemisphere};
 use heliodon_core::time::{Date, LocalDateTime, TimeOfDay};
+use quick_light::quick_light;
 
 fn load(path: &Path) -> Arc<Scene> {
     Arc::new(load_scene(path, &PanelCatalog::new()).unwrap().scene)
@@ -130,7 +133,7 @@ fn windows_given_their_own_material_change_alone() {
     use heliodon_core::scene::MaterialKind;
     let scene = load(&sideroom());
     let sky = sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "12:00");
-    let solve = |scene: Scene| LightModel::precompute(Arc::new(scene), quick()).unwrap().solve(&sky, None).sensors;
+    let solve = |scene: Scene| LightModel::precompute(Arc::new(scene), quick_light()).unwrap().solve(&sky, None).sensors;
     let before = solve((*scene).clone());
     let mut split = (*scene).clone();
     let wall = split.surfaces.iter().position(|s| !split.material(s.material).kind.transmits()).unwrap() as u32;
@@ -153,23 +156,12 @@ fn windows_given_their_own_material_change_alone() {
     assert!(closed.iter().all(|r| r.total > 0.0));
 }
 
-fn quick() -> LightSettings {
-    LightSettings {
-        rays_per_patch: 64,
-        rays_per_sensor: 512,
-        sky_rays_per_sensor: 512,
-        sun_samples_per_patch: 4,
-        area_sensor_sun_grid: 4,
-        ..Default::default()
-    }
-}
-
 #[test]
 fn results_do_not_depend_on_the_thread_count() {
     let scene = load(&heliodon_core::bundled_scene("test_room"));
     let sky = sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-03-21", "10:00");
-    let one = LightModel::precompute(scene.clone(), LightSettings { threads: Some(1), ..quick() }).unwrap().solve(&sky, None);
-    let three = LightModel::precompute(scene.clone(), LightSettings { threads: Some(3), ..quick() }).unwrap().solve(&sky, None);
+    let one = LightModel::precompute(scene.clone(), LightSettings { threads: Some(1), ..quick_light() }).unwrap().solve(&sky, None);
+    let three = LightModel::precompute(scene.clone(), LightSettings { threads: Some(3), ..quick_light() }).unwrap().solve(&sky, None);
     assert_eq!(one, three);
 }
 
@@ -210,7 +202,7 @@ fn a_sensor_outside_reads_the_open_sky() {
 #[test]
 fn sky_light_is_attributed_to_the_windows_it_comes_through() {
     let scene = load(&sideroom());
-    let model = LightModel::precompute(scene.clone(), quick()).unwrap();
+    let model = LightModel::precompute(scene.clone(), quick_light()).unwrap();
     let sky = sky_at(&scene, &SkySpec::Uniform, "2026-03-21", "12:00");
     let lighting = model.solve(&sky, None);
     let by_window = model.sky_through_windows(&sky);
@@ -245,12 +237,12 @@ fn a_room_without_windows_is_dark_and_the_night_has_no_sun() {
     std::fs::copy(sideroom().with_file_name("model.mtl"), dir.join("model.mtl")).unwrap();
     let scene = load(&dir.join("scene.toml"));
     assert!(scene.windows.is_empty());
-    let model = LightModel::precompute(scene.clone(), quick()).unwrap();
+    let model = LightModel::precompute(scene.clone(), quick_light()).unwrap();
     let lighting = model.solve(&sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-06-21", "12:00"), None);
     assert!(lighting.sensors.iter().all(|r| r.total == 0.0), "{:?}", lighting.sensors[0]);
 
     let scene = load(&sideroom());
-    let model = LightModel::precompute(scene.clone(), quick()).unwrap();
+    let model = LightModel::precompute(scene.clone(), quick_light()).unwrap();
     let night = model.solve(&sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-06-21", "23:00"), None);
     assert!(night.sensors.iter().all(|r| r.direct_sun == 0.0 && r.total == 0.0));
     // Warm-started from the day (as the viewer's relights and day plots are),
@@ -264,7 +256,7 @@ fn a_room_without_windows_is_dark_and_the_night_has_no_sun() {
 #[test]
 fn warm_starts_converge_to_the_same_light() {
     let scene = load(&sideroom());
-    let model = LightModel::precompute(scene.clone(), quick()).unwrap();
+    let model = LightModel::precompute(scene.clone(), quick_light()).unwrap();
     let first = model.solve(&sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "09:00"), None);
     let sky = sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "10:00");
     let cold = model.solve(&sky, None);
@@ -300,7 +292,7 @@ fn the_cache_is_used_and_never_trusted_when_damaged() {
     }
     let scene = load(&work.join("scene.toml"));
     let sky = sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-03-21", "10:00");
-    let settings = quick();
+    let settings = quick_light();
     let (fresh, outcome) = precompute_cached(scene.clone(), settings, Some(&dir), &|_| {}).unwrap();
     let CacheOutcome::Stored(path) = outcome else { panic!("{outcome:?}") };
     let expected = fresh.solve(&sky, None);
@@ -354,12 +346,12 @@ fn open_models_and_sensors_inside_solids_are_handled() {
     let open = open.replace("\nf 5 6 7 8", "");
     std::fs::write(dir.join("model.obj"), open).unwrap();
     let scene = load(&dir.join("scene.toml"));
-    let model = LightModel::precompute(scene.clone(), quick()).unwrap();
+    let model = LightModel::precompute(scene.clone(), quick_light()).unwrap();
     let lighting = model.solve(&sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "12:00"), None);
     assert!(lighting.sensors.iter().all(|r| r.total.is_finite() && r.total > 0.0));
     // A sensor inside the test room's closed desk-like box is flagged.
     let office = load(&heliodon_core::bundled_scene("office"));
-    assert!(LightModel::precompute(office, quick()).unwrap().sensors_inside_solids().is_empty());
+    assert!(LightModel::precompute(office, quick_light()).unwrap().sensors_inside_solids().is_empty());
     let inside = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_inside");
     std::fs::create_dir_all(&inside).unwrap();
     let scene_text = std::fs::read_to_string(heliodon_core::bundled_scene("office")).unwrap()
@@ -369,7 +361,7 @@ fn open_models_and_sensors_inside_solids_are_handled() {
         std::fs::copy(heliodon_core::bundled_scene("office").with_file_name(f), inside.join(f)).unwrap();
     }
     let scene = load(&inside.join("scene.toml"));
-    let flagged = LightModel::precompute(scene.clone(), quick()).unwrap().sensors_inside_solids();
+    let flagged = LightModel::precompute(scene.clone(), quick_light()).unwrap().sensors_inside_solids();
     assert_eq!(flagged.iter().map(|&i| scene.sensors[i].name.as_str()).collect::<Vec<_>>(), ["in-partition"]);
 }
 
@@ -520,7 +512,7 @@ fn survey_coordinates_are_recentred_for_precision() {
 #[test]
 fn sensor_coefficients_read_what_a_radiosity_solve_reads() {
     let scene = load(&heliodon_core::bundled_scene("office"));
-    let model = LightModel::precompute(scene.clone(), quick()).unwrap();
+    let model = LightModel::precompute(scene.clone(), quick_light()).unwrap();
     let coefficients = model.sensor_coefficients();
     let perez =
         |dni: f64, dhi: f64| SkySpec::Perez(heliodon_core::sky::perez::Input::Irradiance { direct_normal: dni, diffuse_horizontal: dhi });
