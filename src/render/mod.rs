@@ -136,11 +136,21 @@ impl RenderSettings {
 }
 
 impl VerticalSection {
+    /// The section hiding what lies beyond `point` toward `azimuth`.
+    pub fn through(point: Vec3, azimuth: f32) -> Self {
+        Self { azimuth, offset: normal(azimuth).dot(point.truncate()) }
+    }
+
     /// The plane's horizontal normal toward the hidden side, and its offset.
     pub fn plane(&self) -> Vec4 {
-        let (sin, cos) = self.azimuth.to_radians().sin_cos();
-        Vec4::new(sin, cos, 0.0, self.offset)
+        normal(self.azimuth).extend(0.0).extend(self.offset)
     }
+}
+
+/// The horizontal unit vector toward `azimuth` (degrees clockwise from +y).
+fn normal(azimuth: f32) -> Vec2 {
+    let (sin, cos) = azimuth.to_radians().sin_cos();
+    Vec2::new(sin, cos)
 }
 
 impl Default for RenderSettings {
@@ -420,5 +430,7 @@ mod tests {
         // East: x over 2 m hidden.
         let east = RenderSettings { vertical_section: Some(VerticalSection { azimuth: 90.0, offset: 2.0 }), ..Default::default() };
         assert!(east.cuts_away(DVec3::new(2.5, 0.0, 0.0)) && !east.cuts_away(DVec3::new(1.5, 0.0, 0.0)));
+        let through = VerticalSection::through(Vec3::new(2.0, 5.0, 1.0), 90.0);
+        assert!((through.offset - 2.0).abs() < 1e-6, "{through:?}");
     }
 }

@@ -111,12 +111,7 @@ impl super::LightModel {
     /// model's lowest point under its middle. `None` with no ceiling found.
     pub fn storey_section(&self, eye: glam::Vec3) -> Option<f32> {
         let ceiling_above = |from: glam::Vec3| self.trace(from.as_dvec3(), DVec3::Z).map(|(_, d)| from.z + d as f32);
-        let (lo, hi) = self
-            .scene
-            .patches
-            .patches
-            .iter()
-            .fold((glam::Vec3::MAX, glam::Vec3::MIN), |(lo, hi), p| (lo.min(p.centroid), hi.max(p.centroid)));
+        let (lo, hi) = self.scene.bounds;
         let inside = ceiling_above(eye).filter(|&c| c < hi.z + 1e-3 && self.trace(eye.as_dvec3(), -DVec3::Z).is_some());
         let ceiling = inside
             .or_else(|| self.interior_view().and_then(|v| ceiling_above(v.eye)))

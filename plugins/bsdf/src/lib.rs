@@ -449,19 +449,17 @@ impl MeasuredTransmission for Transmission {
     }
 
     fn row(&self, incoming: DVec3) -> Vec<f64> {
-        let row = match self {
-            Self::Klems { rings, matrix } => {
-                let patch = Self::patch(rings, incoming);
-                (0..matrix.values.len() / matrix.incoming).map(|o| matrix.get(patch, o)).collect::<Vec<f64>>()
-            }
+        match self {
+            // A Klems file is constant over its incoming patches.
+            Self::Klems { rings, .. } => self.patch_row(Self::patch(rings, incoming)),
             Self::Tree { tree, reciprocal, cells, .. } => (0..cells * cells)
                 .map(|k| {
                     let out = cell_direction(k, *cells, 1.0);
-                    if *reciprocal { tree.value(out, -incoming) } else { tree.value(-incoming, out) }
+                    let value = if *reciprocal { tree.value(out, -incoming) } else { tree.value(-incoming, out) };
+                    value.max(0.0)
                 })
                 .collect(),
-        };
-        row.into_iter().map(|f| f.max(0.0)).collect()
+        }
     }
 }
 

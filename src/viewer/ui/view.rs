@@ -35,14 +35,14 @@ impl ViewPanel<'_, '_> {
         let model = self.engine.as_ref().and_then(|e| e.model.clone());
         let storey = || model.as_ref()?.storey_section(eye?);
         section_row(ui, settings, camera, storey, note);
-        // A vertical one by default through the model's middle, hiding the half toward the camera.
+        // A vertical one by default through the middle of what the scene is
+        // about (its windows and sensors), hiding the half toward the camera.
         let across = || {
-            let scene = &model.as_ref()?.scene;
-            let count = scene.patches.patches.len().max(1) as f32;
-            let middle = scene.patches.patches.iter().map(|p| p.centroid).sum::<Vec3>() / count;
+            let (lo, hi) = model.as_ref()?.scene.focus;
+            let middle = (lo + hi) / 2.0;
             let toward = (eye? - middle).truncate();
             let azimuth = toward.x.atan2(toward.y).to_degrees().rem_euclid(360.0);
-            Some(VerticalSection { azimuth, offset: VerticalSection { azimuth, offset: 0.0 }.plane().truncate().dot(middle) })
+            Some(VerticalSection::through(middle, azimuth))
         };
         vertical_section_row(ui, settings, across, note);
     }
