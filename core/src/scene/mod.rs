@@ -31,7 +31,7 @@ use glam::Vec3;
 pub use error::{Location, SceneError, SceneWarning, line_of};
 pub use frame::{ModelFrame, UpAxis};
 pub use material::{Material, MaterialKind, MaterialOrigin, Rgb};
-pub use patches::{Patch, PatchMesh, PatchSizing};
+pub use patches::{Patch, PatchMesh, PatchSizing, WindowPlane};
 pub use sensors::{DEFAULT_FOV, Sensor, Viewpoint};
 pub use shades::ShadeGroup;
 
@@ -328,7 +328,14 @@ fn build(
             ),
         ));
     }
-    let patches = patches::subdivide(&triangles, &mut surfaces, &sizing, &clusterable);
+    let window_planes: Vec<WindowPlane> = windows
+        .iter()
+        .map(|w| {
+            let range = surfaces[w.surface as usize].triangles.clone();
+            WindowPlane::new(w.normal, &triangles[range.start as usize..range.end as usize])
+        })
+        .collect();
+    let patches = patches::subdivide(&triangles, &mut surfaces, &sizing, &clusterable, &window_planes);
     let viewpoints = sensors::viewpoints(&parsed)?;
     let bounds = bounds(&triangles);
     let focus = focus.unwrap_or(bounds);

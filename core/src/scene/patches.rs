@@ -12,6 +12,14 @@
 //! Triangles smaller than their cell are not cut: they join the cell that
 //! holds their centroid (small coplanar triangles gather into patches).
 //!
+//! A window's plane also cuts the surfaces that pass through it near the
+//! window — reveals, sills, lintels, frames, the floor under a door: the
+//! light on them steps there from the outside's to the room's, so no patch
+//! straddles it ([`WindowPlane`]). A reveal cut by a thick wall's glass
+//! plane would otherwise be one patch, lit as the mean of its sunlit outer
+//! half and its inner half, and the room would read that mean: light
+//! leaking round the glass.
+//!
 //! Clutter (furniture, frames, mullions: diffuse surfaces much smaller than
 //! the patch size allowed where they are) would otherwise be one patch per
 //! surface. Such surfaces are gathered into *clusters*: per material, per
@@ -131,6 +139,79 @@ impl PatchSizing {
         let distance = (outside - reach).max(0.0);
         (self.finest + GROWTH * distance).min(self.finest * COARSEST)
     }
+}
+
+/// Surfaces come this near a window (m) for its plane to cut them: the
+/// frame and the wall opening around the glass.
+const NEAR_WINDOW: f32 = 0.3;
+/// Points this near a window's plane (m) lie in it: a surface must reach
+/// further to both sides to be cut.
+const IN_PLANE: f32 = 2e-3;
+
+/// A window's plane, where it cuts patches (see the module's docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindowPlane {
+    normal: Vec3,
+    offset: f32,
+    /// The window's bounds grown by [`NEAR_WINDOW`]: where it cuts.
+    near: (Vec3, Vec3),
+}
+
+impl WindowPlane {
+    /// The plane of a window made of `triangles`, with unit `normal`.
+    pub fn new(normal: Vec3, triangles: &[Triangle]) -> Self {
+        let points = triangles.iter().flat_map(|t| t.vertices);
+        let (lo, hi) = points.clone().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        let count = (3 * triangles.len()).max(1) as f32;
+        let offset = points.map(|p| p.dot(normal)).sum::<f32>() / count;
+        WindowPlane { normal, offset, near: (lo - Vec3::splat(NEAR_WINDOW), hi + Vec3::splat(NEAR_WINDOW)) }
+    }
+
+    fn height(&self, p: Vec3) -> f32 {
+        p.dot(self.normal) - self.offset
+    }
+
+    /// Whether the box (lo, hi) lies near the window.
+    fn is_near(&self, (lo, hi): (Vec3, Vec3)) -> bool {
+        lo.cmple(self.near.1).all() && hi.cmpge(self.near.0).all()
+    }
+
+    /// Whether `tris`, lying in the box `bounds`, pass through the plane
+    /// near the window.
+    fn cuts(&self, tris: &[Triangle], bounds: (Vec3, Vec3)) -> bool {
+        let heights = || tris.iter().flat_map(|t| t.vertices).map(|p| self.height(p));
+        self.is_near(bounds) && heights().any(|h| h > IN_PLANE) && heights().any(|h| h < -IN_PLANE)
+    }
+}
+
+/// The box around `tris`.
+fn bounds_of(tris: &[Triangle]) -> (Vec3, Vec3) {
+    tris.iter().flat_map(|t| t.vertices).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)))
+}
+
+/// Splits a convex `polygon` by `planes` (at most 64), handing each part to
+/// `out` with the set of planes it lies above (bit k for `planes[k]`).
+fn split_by_planes(polygon: Vec<Vec3>, planes: &[&WindowPlane], out: &mut impl FnMut(u64, Vec<Vec3>)) {
+    fn split(polygon: Vec<Vec3>, planes: &[&WindowPlane], k: usize, above: u64, out: &mut impl FnMut(u64, Vec<Vec3>)) {
+        let Some(plane) = planes.get(k) else {
+            return out(above, polygon);
+        };
+        let bit = 1 << k;
+        let heights = polygon.iter().map(|&p| plane.height(p));
+        if heights.clone().all(|h| h >= 0.0) {
+            return split(polygon, planes, k + 1, above | bit, out);
+        }
+        if heights.clone().all(|h| h <= 0.0) {
+            return split(polygon, planes, k + 1, above, out);
+        }
+        for (keep_above, mask) in [(true, bit), (false, 0)] {
+            let part = clip(&polygon, plane.normal, plane.offset, keep_above);
+            if part.len() >= 3 {
+                split(part, planes, k + 1, above | mask, out);
+            }
+        }
+    }
+    split(polygon, &planes[..planes.len().min(64)], 0, 0, out);
 }
 
 /// A square cell of a surface's quadtree, in finest-grid units from the
@@ -275,9 +356,18 @@ const CLUTTER: f32 = 0.25;
 
 /// The clusters of clutter: per surface, its cluster (index into the
 /// returned list of member lists), for the surfaces that `clusterable`
-/// allows and that are small where they lie.
-fn clusters(triangles: &[Triangle], surfaces: &[Surface], sizing: &PatchSizing, clusterable: &[bool]) -> (Vec<Option<u32>>, Vec<Vec<u32>>) {
-    let mut keys: BTreeMap<(u32, u8, [i64; 3]), u32> = BTreeMap::new();
+/// allows, that are small where they lie and that no window plane cuts.
+/// Clutter on the two sides of a window's plane (frames outside and in)
+/// never shares a cluster.
+fn clusters(
+    triangles: &[Triangle],
+    surfaces: &[Surface],
+    sizing: &PatchSizing,
+    clusterable: &[bool],
+    cuts: &[WindowPlane],
+) -> (Vec<Option<u32>>, Vec<Vec<u32>>) {
+    type Key = (u32, u8, [i64; 3], Vec<(u32, bool)>);
+    let mut keys: BTreeMap<Key, u32> = BTreeMap::new();
     let mut members: Vec<Vec<u32>> = Vec::new();
     let mut cluster_of = vec![None; surfaces.len()];
     for (index, surface) in surfaces.iter().enumerate() {
@@ -287,6 +377,11 @@ fn clusters(triangles: &[Triangle], surfaces: &[Surface], sizing: &PatchSizing, 
         if !clusterable[index] || surface.area >= CLUTTER * allowed * allowed {
             continue;
         }
+        let bounds = bounds_of(tris);
+        if cuts.iter().any(|c| c.cuts(tris, bounds)) {
+            continue;
+        }
+        let sides = cuts.iter().enumerate().filter(|(_, c)| c.is_near(bounds)).map(|(k, c)| (k as u32, c.height(centroid) > 0.0)).collect();
         // Cubes of the allowed side, nested on the finest grid.
         let side = sizing.finest * (allowed / sizing.finest).log2().floor().exp2();
         let cube = (centroid / side).floor().as_i64vec3().to_array();
@@ -294,7 +389,7 @@ fn clusters(triangles: &[Triangle], surfaces: &[Surface], sizing: &PatchSizing, 
         let axis = n.abs().max_position();
         let direction = (2 * axis + usize::from(n[axis] < 0.0)) as u8;
         let next = members.len() as u32;
-        let cluster = *keys.entry((surface.material, direction, cube)).or_insert(next);
+        let cluster = *keys.entry((surface.material, direction, cube, sides)).or_insert(next);
         if cluster == next {
             members.push(Vec::new());
         }
@@ -304,12 +399,18 @@ fn clusters(triangles: &[Triangle], surfaces: &[Surface], sizing: &PatchSizing, 
     (cluster_of, members)
 }
 
-/// Cuts every surface into patches no larger than `sizing` allows, gathers
-/// the clutter among the surfaces `clusterable` allows into clusters, and
-/// sets each surface's patch range.
-pub fn subdivide(triangles: &[Triangle], surfaces: &mut [Surface], sizing: &PatchSizing, clusterable: &[bool]) -> PatchMesh {
+/// Cuts every surface into patches no larger than `sizing` allows and
+/// along the window planes `cuts`, gathers the clutter among the surfaces
+/// `clusterable` allows into clusters, and sets each surface's patch range.
+pub fn subdivide(
+    triangles: &[Triangle],
+    surfaces: &mut [Surface],
+    sizing: &PatchSizing,
+    clusterable: &[bool],
+    cuts: &[WindowPlane],
+) -> PatchMesh {
     let mut mesh = PatchMesh::default();
-    let (cluster_of, members) = clusters(triangles, surfaces, sizing, clusterable);
+    let (cluster_of, members) = clusters(triangles, surfaces, sizing, clusterable, cuts);
     for index in 0..surfaces.len() {
         let first_patch = mesh.patches.len() as u32;
         if let Some(cluster) = cluster_of[index] {
@@ -326,14 +427,28 @@ pub fn subdivide(triangles: &[Triangle], surfaces: &mut [Surface], sizing: &Patc
         let tree = Quadtree::for_surface(sizing, surface, tris);
         let (u, v) = (tree.u, tree.v);
         let cell_of = |p: Vec3| tree.cell_of(p);
-        let mut cells: BTreeMap<(i64, i64), Vec<[Vec3; 3]>> = BTreeMap::new();
+        let bounds = bounds_of(tris);
+        let planes: Vec<&WindowPlane> = cuts.iter().filter(|c| c.cuts(tris, bounds)).collect();
+        // Per leaf cell and side of the window planes: its pieces.
+        let mut cells: BTreeMap<(i64, i64, u64), Vec<[Vec3; 3]>> = BTreeMap::new();
+        let mut add = |cell: Cell, polygon: Vec<Vec3>| {
+            split_by_planes(polygon, &planes, &mut |above, part| {
+                let pieces = cells.entry((cell.i, cell.j, above)).or_default();
+                for k in 1..part.len().saturating_sub(1) {
+                    let piece = [part[0], part[k], part[k + 1]];
+                    if 0.5 * (piece[1] - piece[0]).cross(piece[2] - piece[0]).length() > SLIVER_AREA {
+                        pieces.push(piece);
+                    }
+                }
+            })
+        };
         let mut leaves = Vec::new();
         for triangle in tris {
             let [a, b, c] = triangle.vertices;
             let longest = (b - a).length().max((c - b).length()).max((a - c).length());
             let home = tree.leaf_at(cell_of(triangle.centroid()));
             if longest <= tree.bounds(home).2 {
-                cells.entry((home.i, home.j)).or_default().push(triangle.vertices);
+                add(home, triangle.vertices.to_vec());
                 continue;
             }
             let (lo, hi) =
@@ -352,12 +467,8 @@ pub fn subdivide(triangles: &[Triangle], surfaces: &mut [Surface], sizing: &Patc
                         break;
                     }
                 }
-                let pieces = cells.entry((leaf.i, leaf.j)).or_default();
-                for k in 1..polygon.len().saturating_sub(1) {
-                    let piece = [polygon[0], polygon[k], polygon[k + 1]];
-                    if 0.5 * (piece[1] - piece[0]).cross(piece[2] - piece[0]).length() > SLIVER_AREA {
-                        pieces.push(piece);
-                    }
+                if polygon.len() >= 3 {
+                    add(leaf, polygon);
                 }
             }
         }
@@ -435,7 +546,7 @@ mod tests {
     fn a_wall_becomes_a_grid_of_square_patches_that_conserve_area() {
         let tris = quad(4.0, 3.0);
         let mut surfaces = vec![surface_of(&tris)];
-        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false]);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[]);
         assert_eq!(mesh.patches.len(), 8 * 6);
         assert_eq!(surfaces[0].patches, 0..48);
         for patch in &mesh.patches {
@@ -459,7 +570,7 @@ mod tests {
     fn a_partial_cell_keeps_its_share() {
         let tris = quad(1.2, 0.5);
         let mut surfaces = vec![surface_of(&tris)];
-        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false]);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[]);
         let mut areas: Vec<f32> = mesh.patches.iter().map(|p| p.area).collect();
         areas.sort_by(f32::total_cmp);
         assert_eq!(areas.len(), 3);
@@ -479,7 +590,7 @@ mod tests {
             })
             .collect();
         let mut surfaces = vec![surface_of(&tris)];
-        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false]);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[]);
         assert_eq!(mesh.triangles.len(), 6);
         assert_eq!(mesh.patches.len(), 2);
         let total: f32 = mesh.patches.iter().map(|p| p.area).sum();
@@ -509,7 +620,7 @@ mod tests {
             surfaces.push(Surface { triangles: start..tris.len() as u32, ..surface_of(&square) });
         }
         let clusterable = vec![true; surfaces.len()];
-        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &clusterable);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &clusterable, &[]);
         assert_eq!(mesh.patches.len(), 2, "{:?}", mesh.patches.iter().map(|p| p.normal).collect::<Vec<_>>());
         let area: f32 = mesh.patches.iter().map(|p| p.area).sum();
         assert!((area - 0.4).abs() < 1e-5, "{area}");
