@@ -802,3 +802,26 @@ fn no_light_leaks_round_the_glass_of_a_thick_wall() {
         assert!((one - two).abs() < 0.02 * two, "{spec:?}: one surface through the glass {one} lx, two meeting at it {two} lx");
     }
 }
+
+/// A window's outward side is the one that sees the sky; glazing that sees
+/// none from either side (a pane between two rooms, or glass shut inside a
+/// door leaf) is said to be enclosed, not given a guessed facing.
+#[test]
+fn interior_glazing_is_enclosed_and_a_facade_window_faces_out() {
+    let path = room_in_a_thick_wall(&Path::new(env!("CARGO_TARGET_TMPDIR")).join("interior_pane"), true);
+    // A glass partition across the room, 3 m in.
+    let mut obj = std::fs::read_to_string(path.with_file_name("room.obj")).unwrap();
+    obj.push_str("usemtl glass\nv 0.5 3 0.5\nv 3.5 3 0.5\nv 3.5 3 2.5\nv 0.5 3 2.5\nf -4 -3 -2 -1\n");
+    std::fs::write(path.with_file_name("room.obj"), obj).unwrap();
+    let scene = load(&path);
+    let model = LightModel::unlit(scene.clone());
+    assert_eq!(scene.windows.len(), 2);
+    for (k, window) in scene.windows.iter().enumerate() {
+        let facade = window.centroid.y < 0.0;
+        let group = &model.windows.groups[model.windows.group_of_window[k] as usize];
+        assert_eq!(group.enclosed, !facade, "window {k} at {}", window.centroid);
+        if facade {
+            assert!(group.outward.y < -0.99, "the façade window faces south: {}", group.outward);
+        }
+    }
+}

@@ -1,7 +1,7 @@
 //! Window groups: the one rule by which windows are grouped everywhere —
 //! the light engine's panel groups, the sun pass's apertures, the viewer's
 //! windows panel and `info`. A group is the windows of one material whose
-//! **outward** normals agree. A window's outward side is the side from
+//! **outward** normals agree (and that all see sky, or all none). A window's outward side is the side from
 //! which more sky is seen (ray-tested), not the side its polygon's normal
 //! happens to point to: exported models wind their faces either way.
 
@@ -24,6 +24,10 @@ pub struct WindowGroup {
     pub material: u32,
     /// Unit normal toward the outside (the side that sees the sky).
     pub outward: DVec3,
+    /// No test ray from either side of its windows reached the sky
+    /// (interior glazing, or glass shut inside other surfaces, as a door
+    /// leaf's box around its panes): `outward` is then a guess.
+    pub enclosed: bool,
     /// Indices into [`Scene::windows`].
     pub windows: Vec<u32>,
 }
@@ -44,12 +48,13 @@ impl WindowGroups {
     pub(super) fn new(scene: &Scene, tracer: &Tracer) -> Self {
         let mut out = Self::default();
         for (index, window) in scene.windows.iter().enumerate() {
-            let outward = outward_normal(tracer, window);
-            let same = |g: &WindowGroup| g.material == window.material && g.outward.dot(outward) > 1.0 - SAME_FACING;
+            let (outward, enclosed) = outward_normal(tracer, window);
+            let same =
+                |g: &WindowGroup| g.material == window.material && g.enclosed == enclosed && g.outward.dot(outward) > 1.0 - SAME_FACING;
             let group = match out.groups.iter().position(same) {
                 Some(group) => group,
                 None => {
-                    out.groups.push(WindowGroup { material: window.material, outward, windows: Vec::new() });
+                    out.groups.push(WindowGroup { material: window.material, outward, enclosed, windows: Vec::new() });
                     out.groups.len() - 1
                 }
             };
@@ -62,8 +67,9 @@ impl WindowGroups {
 }
 
 /// The normal of `window` turned toward the outside: the side from which
-/// more of the sky is seen (on a tie, against the polygon's normal).
-fn outward_normal(tracer: &Tracer, window: &Window) -> DVec3 {
+/// more of the sky is seen (on a tie, against the polygon's normal); and
+/// whether neither side sees any.
+fn outward_normal(tracer: &Tracer, window: &Window) -> (DVec3, bool) {
     let normal = window.normal.as_dvec3();
     let centre = window.centroid.as_dvec3();
     let mut rng = Rng::new(5, u64::from(window.surface));
@@ -72,7 +78,7 @@ fn outward_normal(tracer: &Tracer, window: &Window) -> DVec3 {
     };
     let along = open(normal, &mut rng);
     let against = open(-normal, &mut rng);
-    if along > against { normal } else { -normal }
+    (if along > against { normal } else { -normal }, along + against == 0)
 }
 
 /// Eye height above the floor for an automatic view, m.

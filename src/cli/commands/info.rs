@@ -98,7 +98,11 @@ pub fn info(scene: &Scene, windows: &WindowGroups) -> String {
             "  #{i:<3} {:<14} {:6.2} m²  facing {}  centre ({:.2}, {:.2}, {:.2})",
             scene.material(window.material).name,
             window.area,
-            compass(windows.outward[i].as_vec3()),
+            if windows.groups[windows.group_of_window[i] as usize].enclosed {
+                "nowhere (sees no sky from either side)".to_string()
+            } else {
+                compass(windows.outward[i].as_vec3())
+            },
             c.x,
             c.y,
             c.z

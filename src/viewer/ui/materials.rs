@@ -62,8 +62,8 @@ pub struct MaterialPanel<'w, 's> {
 #[derive(Debug, Clone, PartialEq)]
 pub struct WindowRow {
     pub material: u32,
-    /// Compass point the panes look out to (true north at `north_turn`), or
-    /// "skylight".
+    /// Compass point the panes look out to (true north at `north_turn`),
+    /// "skylight", or "enclosed" (glazing that sees no sky).
     pub facing: &'static str,
     pub panes: usize,
     /// m².
@@ -79,7 +79,9 @@ pub fn window_rows(scene: &Scene, windows: &WindowGroups, north_turn: f64) -> Ve
     let mut rows: Vec<WindowRow> = Vec::new();
     for group in &windows.groups {
         let out = group.outward;
-        let facing = if out.z.abs() > 0.7 {
+        let facing = if group.enclosed {
+            "enclosed"
+        } else if out.z.abs() > 0.7 {
             "skylight"
         } else {
             let azimuth = out.x.atan2(out.y).to_degrees() - north_turn;
