@@ -7,6 +7,7 @@
 //! Radiance). [`ModelFrame`] maps the model's own axes, north and units into it.
 //! [`save`] writes a scene's edits back into its file.
 
+mod contacts;
 mod error;
 mod file;
 mod frame;
@@ -31,7 +32,7 @@ use glam::Vec3;
 pub use error::{Location, SceneError, SceneWarning, line_of};
 pub use frame::{ModelFrame, UpAxis};
 pub use material::{Material, MaterialKind, MaterialOrigin, Rgb};
-pub use patches::{Patch, PatchMesh, PatchSizing, WindowPlane};
+pub use patches::{CutPlane, Patch, PatchMesh, PatchSizing};
 pub use sensors::{DEFAULT_FOV, Sensor, Viewpoint};
 pub use shades::ShadeGroup;
 
@@ -328,14 +329,15 @@ fn build(
             ),
         ));
     }
-    let window_planes: Vec<WindowPlane> = windows
+    let window_planes: Vec<CutPlane> = windows
         .iter()
         .map(|w| {
             let range = surfaces[w.surface as usize].triangles.clone();
-            WindowPlane::new(w.normal, &triangles[range.start as usize..range.end as usize])
+            CutPlane::around_window(w.normal, &triangles[range.start as usize..range.end as usize])
         })
         .collect();
-    let patches = patches::subdivide(&triangles, &mut surfaces, &sizing, &clusterable, &window_planes);
+    let contacts = contacts::contact_cuts(&triangles, &surfaces);
+    let patches = patches::subdivide(&triangles, &mut surfaces, &sizing, &clusterable, &window_planes, &contacts);
     let viewpoints = sensors::viewpoints(&parsed)?;
     let bounds = bounds(&triangles);
     let focus = focus.unwrap_or(bounds);

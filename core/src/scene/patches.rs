@@ -15,7 +15,7 @@
 //! A window's plane also cuts the surfaces that pass through it near the
 //! window — reveals, sills, lintels, frames, the floor under a door: the
 //! light on them steps there from the outside's to the room's, so no patch
-//! straddles it ([`WindowPlane`]). A reveal cut by a thick wall's glass
+//! straddles it ([`CutPlane`]). A reveal cut by a thick wall's glass
 //! plane would otherwise be one patch, lit as the mean of its sunlit outer
 //! half and its inner half, and the room would read that mean: light
 //! leaking round the glass.
@@ -144,40 +144,45 @@ impl PatchSizing {
 /// Surfaces come this near a window (m) for its plane to cut them: the
 /// frame and the wall opening around the glass.
 const NEAR_WINDOW: f32 = 0.3;
-/// Points this near a window's plane (m) lie in it: a surface must reach
+/// Points this near a cutting plane (m) lie in it: a surface must reach
 /// further to both sides to be cut.
-const IN_PLANE: f32 = 2e-3;
+pub(crate) const IN_PLANE: f32 = 2e-3;
 
-/// A window's plane, where it cuts patches (see the module's docs).
+/// A plane along which the light on a surface may step, so patches are
+/// cut there: a window's plane (see the module's docs) or the face of
+/// another surface that meets this one ([`super::contacts`]). It cuts only
+/// within its `near` box, so a table leg does not cut a floor across the
+/// room.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WindowPlane {
-    normal: Vec3,
-    offset: f32,
-    /// The window's bounds grown by [`NEAR_WINDOW`]: where it cuts.
-    near: (Vec3, Vec3),
+pub struct CutPlane {
+    pub(crate) normal: Vec3,
+    pub(crate) offset: f32,
+    /// Where it cuts: pieces whose box meets this one.
+    pub(crate) near: (Vec3, Vec3),
 }
 
-impl WindowPlane {
-    /// The plane of a window made of `triangles`, with unit `normal`.
-    pub fn new(normal: Vec3, triangles: &[Triangle]) -> Self {
+impl CutPlane {
+    /// The plane of a window made of `triangles`, with unit `normal`,
+    /// cutting within [`NEAR_WINDOW`] of it.
+    pub fn around_window(normal: Vec3, triangles: &[Triangle]) -> Self {
+        let (lo, hi) = bounds_of(triangles);
         let points = triangles.iter().flat_map(|t| t.vertices);
-        let (lo, hi) = points.clone().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
         let count = (3 * triangles.len()).max(1) as f32;
         let offset = points.map(|p| p.dot(normal)).sum::<f32>() / count;
-        WindowPlane { normal, offset, near: (lo - Vec3::splat(NEAR_WINDOW), hi + Vec3::splat(NEAR_WINDOW)) }
+        CutPlane { normal, offset, near: (lo - Vec3::splat(NEAR_WINDOW), hi + Vec3::splat(NEAR_WINDOW)) }
     }
 
     fn height(&self, p: Vec3) -> f32 {
         p.dot(self.normal) - self.offset
     }
 
-    /// Whether the box (lo, hi) lies near the window.
+    /// Whether the box (lo, hi) meets the plane's `near` box.
     fn is_near(&self, (lo, hi): (Vec3, Vec3)) -> bool {
         lo.cmple(self.near.1).all() && hi.cmpge(self.near.0).all()
     }
 
     /// Whether `tris`, lying in the box `bounds`, pass through the plane
-    /// near the window.
+    /// where it cuts.
     fn cuts(&self, tris: &[Triangle], bounds: (Vec3, Vec3)) -> bool {
         let heights = || tris.iter().flat_map(|t| t.vertices).map(|p| self.height(p));
         self.is_near(bounds) && heights().any(|h| h > IN_PLANE) && heights().any(|h| h < -IN_PLANE)
@@ -185,24 +190,33 @@ impl WindowPlane {
 }
 
 /// The box around `tris`.
-fn bounds_of(tris: &[Triangle]) -> (Vec3, Vec3) {
+pub(crate) fn bounds_of(tris: &[Triangle]) -> (Vec3, Vec3) {
     tris.iter().flat_map(|t| t.vertices).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)))
 }
 
 /// Splits a convex `polygon` by `planes` (at most 64), handing each part to
-/// `out` with the set of planes it lies above (bit k for `planes[k]`).
-fn split_by_planes(polygon: Vec<Vec3>, planes: &[&WindowPlane], out: &mut impl FnMut(u64, Vec<Vec3>)) {
-    fn split(polygon: Vec<Vec3>, planes: &[&WindowPlane], k: usize, above: u64, out: &mut impl FnMut(u64, Vec<Vec3>)) {
+/// `out` with the set of planes it lies above (bit k for `planes[k]`). A
+/// plane whose `near` box the part does not meet leaves it whole, on the
+/// side of its centroid.
+fn split_by_planes(polygon: Vec<Vec3>, planes: &[&CutPlane], out: &mut impl FnMut(u64, Vec<Vec3>)) {
+    fn split(polygon: Vec<Vec3>, planes: &[&CutPlane], k: usize, above: u64, out: &mut impl FnMut(u64, Vec<Vec3>)) {
         let Some(plane) = planes.get(k) else {
             return out(above, polygon);
         };
         let bit = 1 << k;
         let heights = polygon.iter().map(|&p| plane.height(p));
-        if heights.clone().all(|h| h >= 0.0) {
-            return split(polygon, planes, k + 1, above | bit, out);
-        }
-        if heights.clone().all(|h| h <= 0.0) {
-            return split(polygon, planes, k + 1, above, out);
+        let bounds = polygon.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let whole_above = if !plane.is_near(bounds) {
+            Some(plane.height(polygon.iter().copied().sum::<Vec3>() / polygon.len() as f32) > 0.0)
+        } else if heights.clone().all(|h| h >= 0.0) {
+            Some(true)
+        } else if heights.clone().all(|h| h <= 0.0) {
+            Some(false)
+        } else {
+            None
+        };
+        if let Some(whole_above) = whole_above {
+            return split(polygon, planes, k + 1, if whole_above { above | bit } else { above }, out);
         }
         for (keep_above, mask) in [(true, bit), (false, 0)] {
             let part = clip(&polygon, plane.normal, plane.offset, keep_above);
@@ -364,7 +378,7 @@ fn clusters(
     surfaces: &[Surface],
     sizing: &PatchSizing,
     clusterable: &[bool],
-    cuts: &[WindowPlane],
+    cuts: &[CutPlane],
 ) -> (Vec<Option<u32>>, Vec<Vec<u32>>) {
     type Key = (u32, u8, [i64; 3], Vec<(u32, bool)>);
     let mut keys: BTreeMap<Key, u32> = BTreeMap::new();
@@ -399,15 +413,18 @@ fn clusters(
     (cluster_of, members)
 }
 
-/// Cuts every surface into patches no larger than `sizing` allows and
-/// along the window planes `cuts`, gathers the clutter among the surfaces
-/// `clusterable` allows into clusters, and sets each surface's patch range.
+/// Cuts every surface into patches no larger than `sizing` allows, along
+/// the window planes `cuts` and along each surface's `contacts` (per
+/// surface, the faces that meet it; see [`super::contacts`]), gathers the
+/// clutter among the surfaces `clusterable` allows into clusters, and sets
+/// each surface's patch range.
 pub fn subdivide(
     triangles: &[Triangle],
     surfaces: &mut [Surface],
     sizing: &PatchSizing,
     clusterable: &[bool],
-    cuts: &[WindowPlane],
+    cuts: &[CutPlane],
+    contacts: &[Vec<CutPlane>],
 ) -> PatchMesh {
     let mut mesh = PatchMesh::default();
     let (cluster_of, members) = clusters(triangles, surfaces, sizing, clusterable, cuts);
@@ -428,7 +445,7 @@ pub fn subdivide(
         let (u, v) = (tree.u, tree.v);
         let cell_of = |p: Vec3| tree.cell_of(p);
         let bounds = bounds_of(tris);
-        let planes: Vec<&WindowPlane> = cuts.iter().filter(|c| c.cuts(tris, bounds)).collect();
+        let planes: Vec<&CutPlane> = cuts.iter().filter(|c| c.cuts(tris, bounds)).chain(&contacts[index]).collect();
         // Per leaf cell and side of the window planes: its pieces.
         let mut cells: BTreeMap<(i64, i64, u64), Vec<[Vec3; 3]>> = BTreeMap::new();
         let mut add = |cell: Cell, polygon: Vec<Vec3>| {
@@ -546,7 +563,7 @@ mod tests {
     fn a_wall_becomes_a_grid_of_square_patches_that_conserve_area() {
         let tris = quad(4.0, 3.0);
         let mut surfaces = vec![surface_of(&tris)];
-        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[]);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[], &[vec![]]);
         assert_eq!(mesh.patches.len(), 8 * 6);
         assert_eq!(surfaces[0].patches, 0..48);
         for patch in &mesh.patches {
@@ -570,7 +587,7 @@ mod tests {
     fn a_partial_cell_keeps_its_share() {
         let tris = quad(1.2, 0.5);
         let mut surfaces = vec![surface_of(&tris)];
-        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[]);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[], &[vec![]]);
         let mut areas: Vec<f32> = mesh.patches.iter().map(|p| p.area).collect();
         areas.sort_by(f32::total_cmp);
         assert_eq!(areas.len(), 3);
@@ -590,7 +607,7 @@ mod tests {
             })
             .collect();
         let mut surfaces = vec![surface_of(&tris)];
-        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[]);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[], &[vec![]]);
         assert_eq!(mesh.triangles.len(), 6);
         assert_eq!(mesh.patches.len(), 2);
         let total: f32 = mesh.patches.iter().map(|p| p.area).sum();
@@ -620,7 +637,7 @@ mod tests {
             surfaces.push(Surface { triangles: start..tris.len() as u32, ..surface_of(&square) });
         }
         let clusterable = vec![true; surfaces.len()];
-        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &clusterable, &[]);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &clusterable, &[], &vec![vec![]; 40]);
         assert_eq!(mesh.patches.len(), 2, "{:?}", mesh.patches.iter().map(|p| p.normal).collect::<Vec<_>>());
         let area: f32 = mesh.patches.iter().map(|p| p.area).sum();
         assert!((area - 0.4).abs() < 1e-5, "{area}");

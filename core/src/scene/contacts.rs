@@ -1,0 +1,234 @@
+//! Contacts: where another face meets a surface — a wall standing on a
+//! slab, a slab running through a wall, a roof's underside running on past
+//! the walls as eaves. The light steps there (a room on one side; the
+//! inside of a wall, or outdoors, on the other), so the patches of the
+//! surface are cut along the meeting face's plane, near where they meet
+//! ([`CutPlane`]). Without it one patch is lit as the mean of both sides,
+//! and the room reads the soffit's light, or the dark under a wall, in its
+//! ceiling and floor. This is discontinuity meshing along the model's own
+//! contact lines, not along shadow edges.
+
+use std::collections::HashMap;
+
+use glam::{IVec3, Vec2, Vec3};
+
+use super::patches::{CutPlane, IN_PLANE, bounds_of};
+use super::{Surface, Triangle};
+
+/// A surface takes at most this many contact planes (the longest contacts).
+const MAX_CUTS: usize = 64;
+/// Side of the grid cells that find the faces near a surface, m.
+const CELL: f32 = 1.0;
+/// Faces spanning more cells than this are checked against every surface.
+const MAX_CELLS: i64 = 4096;
+/// Contacts shorter than this (m) are points, not lines.
+const MIN_CONTACT: f32 = 0.01;
+/// A contact cuts the pieces within this distance of it, m.
+const CONTACT_REACH: f32 = 0.01;
+
+/// Per surface, the planes of the faces that meet it along a line inside
+/// it, where its patches are cut.
+pub fn contact_cuts(triangles: &[Triangle], surfaces: &[Surface]) -> Vec<Vec<CutPlane>> {
+    let grid = Grid::new(triangles);
+    surfaces
+        .iter()
+        .map(|surface| {
+            let own = surface.triangles.start as usize..surface.triangles.end as usize;
+            let tris = &triangles[own.clone()];
+            let (lo, hi) = bounds_of(tris);
+            let flat = Flat::new(surface.normal, tris);
+            let mut cuts: Vec<(CutPlane, f32)> = Vec::new();
+            for t in grid.near(lo - Vec3::splat(IN_PLANE), hi + Vec3::splat(IN_PLANE)) {
+                let face = &triangles[t as usize];
+                if own.contains(&(t as usize)) {
+                    continue;
+                }
+                let Some((p, q)) = flat.contact(face) else { continue };
+                let normal = face.normal();
+                let cut = CutPlane {
+                    normal,
+                    offset: normal.dot(face.vertices[0]),
+                    near: (p.min(q) - Vec3::splat(CONTACT_REACH), p.max(q) + Vec3::splat(CONTACT_REACH)),
+                };
+                let length = p.distance(q);
+                let same = |c: &CutPlane| {
+                    let cos = c.normal.dot(cut.normal);
+                    cos.abs() > 0.9999 && (c.offset - cos.signum() * cut.offset).abs() < IN_PLANE
+                };
+                match cuts.iter_mut().find(|(c, _)| same(c)) {
+                    Some((c, total)) => {
+                        c.near = (c.near.0.min(cut.near.0), c.near.1.max(cut.near.1));
+                        *total += length;
+                    }
+                    None => cuts.push((cut, length)),
+                }
+            }
+            cuts.sort_by(|a, b| b.1.total_cmp(&a.1));
+            cuts.into_iter().take(MAX_CUTS).map(|(c, _)| c).collect()
+        })
+        .collect()
+}
+
+/// A surface's plane and its triangles in the plane, to find where other
+/// faces meet it.
+struct Flat {
+    normal: Vec3,
+    offset: f32,
+    u: Vec3,
+    v: Vec3,
+    triangles: Vec<[Vec2; 3]>,
+}
+
+impl Flat {
+    fn new(normal: Vec3, tris: &[Triangle]) -> Self {
+        let u = normal.any_orthonormal_vector();
+        let v = normal.cross(u);
+        let offset = normal.dot(tris[0].vertices[0]);
+        Flat { normal, offset, u, v, triangles: tris.iter().map(|t| t.vertices.map(|p| Vec2::new(p.dot(u), p.dot(v)))).collect() }
+    }
+
+    /// Where `face` meets the surface along a line inside it: the line's
+    /// ends. `None` when it lies wholly to one side, in the plane, or meets
+    /// it only at a point or outside the surface.
+    fn contact(&self, face: &Triangle) -> Option<(Vec3, Vec3)> {
+        let h = face.vertices.map(|p| self.normal.dot(p) - self.offset);
+        let (low, high) = (h.iter().copied().fold(f32::INFINITY, f32::min), h.iter().copied().fold(f32::NEG_INFINITY, f32::max));
+        if low > IN_PLANE || high < -IN_PLANE || (low >= -IN_PLANE && high <= IN_PLANE) {
+            return None;
+        }
+        let mut points: Vec<Vec3> = (0..3).filter(|&k| h[k].abs() <= IN_PLANE).map(|k| face.vertices[k]).collect();
+        for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+            if (h[a] > IN_PLANE && h[b] < -IN_PLANE) || (h[a] < -IN_PLANE && h[b] > IN_PLANE) {
+                let (pa, pb) = (face.vertices[a], face.vertices[b]);
+                points.push(pa + (pb - pa) * (h[a] / (h[a] - h[b])));
+            }
+        }
+        let (p, q) = points
+            .iter()
+            .flat_map(|&p| points.iter().map(move |&q| (p, q)))
+            .max_by(|a, b| a.0.distance_squared(a.1).total_cmp(&b.0.distance_squared(b.1)))?;
+        if p.distance(q) < MIN_CONTACT {
+            return None;
+        }
+        let inside = [0.1, 0.3, 0.5, 0.7, 0.9].iter().any(|&t| self.holds(p.lerp(q, t)));
+        inside.then_some((p, q))
+    }
+
+    /// Whether `point` (near the plane) lies inside one of the triangles.
+    fn holds(&self, point: Vec3) -> bool {
+        let x = Vec2::new(point.dot(self.u), point.dot(self.v));
+        self.triangles.iter().any(|&[a, b, c]| {
+            let d = (b - a).perp_dot(c - a);
+            if d.abs() < 1e-12 {
+                return false;
+            }
+            let (s, t) = ((x - a).perp_dot(c - a) / d, (b - a).perp_dot(x - a) / d);
+            s > 1e-4 && t > 1e-4 && s + t < 1.0 - 1e-4
+        })
+    }
+}
+
+/// Triangles by the grid cells their boxes cover; the largest kept apart.
+struct Grid {
+    cells: HashMap<IVec3, Vec<u32>>,
+    large: Vec<u32>,
+}
+
+impl Grid {
+    fn new(triangles: &[Triangle]) -> Self {
+        let mut grid = Grid { cells: HashMap::new(), large: Vec::new() };
+        for (t, triangle) in triangles.iter().enumerate() {
+            let (lo, hi) = bounds_of(std::slice::from_ref(triangle));
+            let (a, b) = (cell(lo - Vec3::splat(IN_PLANE)), cell(hi + Vec3::splat(IN_PLANE)));
+            let span = (b - a + IVec3::ONE).as_i64vec3();
+            if span.x * span.y * span.z > MAX_CELLS {
+                grid.large.push(t as u32);
+                continue;
+            }
+            for x in a.x..=b.x {
+                for y in a.y..=b.y {
+                    for z in a.z..=b.z {
+                        grid.cells.entry(IVec3::new(x, y, z)).or_default().push(t as u32);
+                    }
+                }
+            }
+        }
+        grid
+    }
+
+    /// The triangles whose cells meet the box (lo, hi), in index order:
+    /// the same order whatever the hash map's.
+    fn near(&self, lo: Vec3, hi: Vec3) -> Vec<u32> {
+        let mut found = self.large.clone();
+        let (a, b) = (cell(lo), cell(hi));
+        let span = (b - a + IVec3::ONE).as_i64vec3();
+        if span.x * span.y * span.z > self.cells.len() as i64 {
+            // A box larger than the occupied grid: walk the grid instead.
+            let inside = |c: &IVec3| c.cmpge(a).all() && c.cmple(b).all();
+            self.cells.iter().filter(|(c, _)| inside(c)).for_each(|(_, list)| found.extend(list));
+        } else {
+            for x in a.x..=b.x {
+                for y in a.y..=b.y {
+                    for z in a.z..=b.z {
+                        found.extend(self.cells.get(&IVec3::new(x, y, z)).into_iter().flatten());
+                    }
+                }
+            }
+        }
+        found.sort_unstable();
+        found.dedup();
+        found
+    }
+}
+
+fn cell(p: Vec3) -> IVec3 {
+    (p / CELL).floor().as_ivec3()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad(material: u32, [a, b, c, d]: [[f32; 3]; 4]) -> Vec<Triangle> {
+        let [a, b, c, d] = [a, b, c, d].map(Vec3::from);
+        vec![Triangle { vertices: [a, b, c], material }, Triangle { vertices: [a, c, d], material }]
+    }
+
+    /// The surfaces of `quads`, one each.
+    fn surfaces(quads: &[Vec<Triangle>]) -> (Vec<Triangle>, Vec<Surface>) {
+        let mut triangles = Vec::new();
+        let mut surfaces = Vec::new();
+        for q in quads {
+            let start = triangles.len() as u32;
+            triangles.extend(q.iter().copied());
+            let cross: Vec3 = q.iter().map(Triangle::cross).sum();
+            surfaces.push(Surface {
+                material: q[0].material,
+                triangles: start..triangles.len() as u32,
+                patches: 0..0,
+                normal: cross.normalize(),
+                area: q.iter().map(Triangle::area).sum(),
+            });
+        }
+        (triangles, surfaces)
+    }
+
+    #[test]
+    fn a_wall_standing_on_a_slab_cuts_it_along_its_foot_only() {
+        let slab = quad(0, [[-2.0, -2.0, 0.0], [6.0, -2.0, 0.0], [6.0, 6.0, 0.0], [-2.0, 6.0, 0.0]]);
+        let wall = quad(1, [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 0.0, 3.0], [0.0, 0.0, 3.0]]);
+        let beside = quad(1, [[0.0, 3.0, 0.5], [4.0, 3.0, 0.5], [4.0, 3.0, 3.0], [0.0, 3.0, 3.0]]);
+        let lying = quad(2, [[1.0, 1.0, 0.0], [2.0, 1.0, 0.0], [2.0, 2.0, 0.0], [1.0, 2.0, 0.0]]);
+        let (triangles, surfaces) = surfaces(&[slab, wall, beside, lying]);
+        let cuts = contact_cuts(&triangles, &surfaces);
+        // The slab: one plane, the wall's (y = 0), cutting along its foot.
+        assert_eq!(cuts[0].len(), 1, "{:?}", cuts[0]);
+        let cut = cuts[0][0];
+        assert!(cut.normal.y.abs() > 0.999 && cut.offset.abs() < 1e-6);
+        assert!(cut.near.0.x > -0.1 && cut.near.1.x < 4.1 && cut.near.1.y - cut.near.0.y < 0.1);
+        // The wall meets the slab along its own bottom edge: not inside it.
+        assert!(cuts[1].is_empty(), "{:?}", cuts[1]);
+        // A face half a metre above and one lying flat on the slab cut nothing.
+        assert!(cuts[2].is_empty() && cuts[3].is_empty());
+    }
+}
