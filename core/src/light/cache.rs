@@ -23,7 +23,7 @@ use crate::sky::SkyPatches;
 
 const MAGIC: &[u8; 8] = b"HELIOLT\0";
 /// Bump when the model or its layout changes.
-const FORMAT: u32 = 7;
+const FORMAT: u32 = 8;
 
 /// What happened to the cache.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -113,6 +113,7 @@ pub fn key(scene: &Scene, settings: &LightSettings) -> u64 {
         hash.u64(u64::from(surface.material));
     }
     hash.u64(settings.rays_per_patch as u64)
+        .u64(settings.window_rays_per_patch as u64)
         .u64(settings.rays_per_sensor as u64)
         .u64(settings.sky_rays_per_sensor as u64)
         .u64(settings.sun_samples_per_patch as u64)

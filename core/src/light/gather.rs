@@ -83,6 +83,20 @@ impl SkyKey {
     }
 }
 
+/// A window that patch sides aim rays at (see `gather_patch_side`).
+struct WindowTarget {
+    /// Index into [`Scene::windows`].
+    window: u32,
+    /// Its triangles with their cumulative areas.
+    triangles: Vec<([DVec3; 3], f64)>,
+    centroid: DVec3,
+    normal: DVec3,
+    /// m².
+    area: f64,
+    /// The diagonal of its box, m.
+    size: f64,
+}
+
 /// A ray that reached a diffuse patch side.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct SideHit {
@@ -165,8 +179,9 @@ impl LightModel {
                 progress(n as f64 / total as f64);
             }
         };
+        let targets = model.window_targets();
         model.side_gathers = par_map(model.settings.threads, patches.len() * 2, |side| {
-            let gather = model.gather_patch_side(side);
+            let gather = model.gather_patch_side(side, &targets);
             tick();
             gather
         });
@@ -238,7 +253,16 @@ impl LightModel {
     /// sides and panels' room sides gather (whatever the panel's back
     /// reflectance: a sweep may change it), glass and panels' outer sides
     /// do not.
-    fn gather_patch_side(&self, side: usize) -> Gather {
+    ///
+    /// The sky through a window the side sees from afar (farther than twice
+    /// the window's size and the patch's) comes from rays aimed at the
+    /// window instead ([`LightSettings::window_rays_per_patch`]): points on
+    /// the windows drawn by their solid angle from the patch, each ray
+    /// weighted by cos·cos·A/(π r² P). The hemisphere rays' sky through
+    /// those windows is dropped, so every path to the sky is counted once,
+    /// by the first window it crosses; near windows keep the hemisphere
+    /// rays (aimed rays would be weighted by 1/r² there).
+    fn gather_patch_side(&self, side: usize, targets: &[WindowTarget]) -> Gather {
         let patch_index = side / 2;
         let gathers = match self.surface_of_patch(patch_index as u32) {
             Surface::Diffuse(_) => true,
@@ -252,13 +276,88 @@ impl LightModel {
         let normal = patch.normal.as_dvec3() * if side % 2 == 1 { -1.0 } else { 1.0 };
         let triangles = self.patch_triangles(patch_index);
         let mut rng = Rng::new(1, side as u64);
-        let directions = cosine_directions(normal, self.settings.rays_per_patch, &mut rng);
+        let hemisphere = self.settings.rays_per_patch;
+        let directions = cosine_directions(normal, hemisphere, &mut rng);
         let (mut coefficients, mut hits) = (Vec::new(), Vec::new());
         for dir in directions {
             let point = sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET;
             self.follow(point, dir, 1.0, 0, None, &mut coefficients, &mut hits);
         }
-        Gather::from_raw(coefficients, &hits, self.settings.rays_per_patch)
+        // The windows seen from afar, with the odds of aiming at each.
+        let centre = patch.centroid.as_dvec3();
+        let reach = patch.area.sqrt() as f64 * std::f64::consts::SQRT_2;
+        let mut aimed: Vec<(usize, f64)> = Vec::new();
+        for (k, target) in targets.iter().enumerate() {
+            let to = target.centroid - centre;
+            let distance = to.length();
+            let cos_here = normal.dot(to) / distance;
+            if self.settings.window_rays_per_patch > 0 && distance > 1.0 * target.size.max(reach) && cos_here > 0.1 {
+                let cos_there = target.normal.dot(to / distance).abs().max(0.1);
+                aimed.push((k, target.area * cos_here * cos_there / (distance * distance)));
+            }
+        }
+        if aimed.is_empty() {
+            return Gather::from_raw(coefficients, &hits, hemisphere);
+        }
+        let bins = self.bin_count();
+        let is_aimed = |key: u32| SkyKey::unpack(key, bins).window.is_some_and(|w| aimed.iter().any(|&(k, _)| targets[k].window == w));
+        coefficients.retain(|&(key, _)| !is_aimed(key));
+        let odds_total: f64 = aimed.iter().map(|a| a.1).sum();
+        let rays = self.settings.window_rays_per_patch;
+        let (mut through, mut ignored) = (Vec::new(), Vec::new());
+        for j in 0..rays {
+            // Stratified over the windows by their odds.
+            let mut pick = (j as f64 + rng.next_f64()) / rays as f64 * odds_total;
+            let &(k, odds) = aimed
+                .iter()
+                .find(|a| {
+                    pick -= a.1;
+                    pick <= 0.0
+                })
+                .unwrap_or(aimed.last().expect("aimed is not empty"));
+            let target = &targets[k];
+            let point = sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET;
+            let to = sample_area(&target.triangles, &mut rng) - point;
+            let r2 = to.length_squared();
+            let dir = to / r2.sqrt();
+            let cos_here = normal.dot(dir);
+            if cos_here <= 0.0 {
+                continue;
+            }
+            let solid_angle = target.area * target.normal.dot(dir).abs() / r2;
+            let weight = cos_here * solid_angle / (std::f64::consts::PI * odds / odds_total) * hemisphere as f64 / rays as f64;
+            through.clear();
+            self.follow(point, dir, weight, 0, None, &mut through, &mut ignored);
+            ignored.clear();
+            coefficients.extend(through.iter().filter(|&&(key, _)| SkyKey::unpack(key, bins).window == Some(target.window)));
+        }
+        Gather::from_raw(coefficients, &hits, hemisphere)
+    }
+
+    /// The windows as targets of aimed rays.
+    fn window_targets(&self) -> Vec<WindowTarget> {
+        let scene = &self.scene;
+        scene
+            .windows
+            .iter()
+            .enumerate()
+            .map(|(k, window)| {
+                let range = scene.surfaces[window.surface as usize].triangles.clone();
+                let triangles = &scene.triangles[range.start as usize..range.end as usize];
+                let (lo, hi) = triangles
+                    .iter()
+                    .flat_map(|t| t.vertices)
+                    .fold((glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+                WindowTarget {
+                    window: k as u32,
+                    triangles: with_cumulative_areas(triangles.iter().map(|t| t.vertices)),
+                    centroid: window.centroid.as_dvec3(),
+                    normal: window.normal.as_dvec3(),
+                    area: f64::from(window.area),
+                    size: f64::from((hi - lo).length()),
+                }
+            })
+            .collect()
     }
 
     /// A patch's render triangles with their cumulative areas.

@@ -6,6 +6,12 @@
 pub struct LightSettings {
     /// Hemisphere rays from each side of each patch (form factors, sky coefficients).
     pub rays_per_patch: usize,
+    /// Rays from each patch side aimed at the windows it sees from afar
+    /// (next-event estimation of the sky through them, see
+    /// [`super::gather`]): a far, small window is a small solid angle that
+    /// hemisphere rays find by chance; aimed rays find it every time. 0:
+    /// hemisphere rays alone.
+    pub window_rays_per_patch: usize,
     /// Hemisphere rays from each sensor point whose landings keep the
     /// sun's first bounce (traced there every relight and every hour of a
     /// year).
@@ -43,6 +49,7 @@ impl Default for LightSettings {
     fn default() -> Self {
         Self {
             rays_per_patch: 256,
+            window_rays_per_patch: 64,
             rays_per_sensor: 4096,
             sky_rays_per_sensor: 16384,
             sun_samples_per_patch: 64,
