@@ -27,9 +27,16 @@ const MIN_CONTACT: f32 = 0.01;
 const CONTACT_REACH: f32 = 0.01;
 
 /// Per surface, the planes of the faces that meet it along a line inside
-/// it, where its patches are cut.
-pub fn contact_cuts(triangles: &[Triangle], surfaces: &[Surface]) -> Vec<Vec<CutPlane>> {
-    let grid = Grid::new(triangles);
+/// it, where its patches are cut. Only faces of surfaces of at least
+/// `min_area` (m²) cut: walls, slabs and roofs make the steps of the light
+/// that matter; a chair leg or a window frame would cut a floor or a wall
+/// into slivers for a step no sensor sees.
+pub fn contact_cuts(triangles: &[Triangle], surfaces: &[Surface], min_area: f32) -> Vec<Vec<CutPlane>> {
+    let mut cutter = vec![false; triangles.len()];
+    for surface in surfaces.iter().filter(|s| s.area >= min_area) {
+        cutter[surface.triangles.start as usize..surface.triangles.end as usize].fill(true);
+    }
+    let grid = Grid::new(triangles, &cutter);
     surfaces
         .iter()
         .map(|surface| {
@@ -135,9 +142,10 @@ struct Grid {
 }
 
 impl Grid {
-    fn new(triangles: &[Triangle]) -> Self {
+    /// The grid of the triangles `keep` marks.
+    fn new(triangles: &[Triangle], keep: &[bool]) -> Self {
         let mut grid = Grid { cells: HashMap::new(), large: Vec::new() };
-        for (t, triangle) in triangles.iter().enumerate() {
+        for (t, triangle) in triangles.iter().enumerate().filter(|(t, _)| keep[*t]) {
             let (lo, hi) = bounds_of(std::slice::from_ref(triangle));
             let (a, b) = (cell(lo - Vec3::splat(IN_PLANE)), cell(hi + Vec3::splat(IN_PLANE)));
             let span = (b - a + IVec3::ONE).as_i64vec3();
@@ -220,7 +228,7 @@ mod tests {
         let beside = quad(1, [[0.0, 3.0, 0.5], [4.0, 3.0, 0.5], [4.0, 3.0, 3.0], [0.0, 3.0, 3.0]]);
         let lying = quad(2, [[1.0, 1.0, 0.0], [2.0, 1.0, 0.0], [2.0, 2.0, 0.0], [1.0, 2.0, 0.0]]);
         let (triangles, surfaces) = surfaces(&[slab, wall, beside, lying]);
-        let cuts = contact_cuts(&triangles, &surfaces);
+        let cuts = contact_cuts(&triangles, &surfaces, 0.01);
         // The slab: one plane, the wall's (y = 0), cutting along its foot.
         assert_eq!(cuts[0].len(), 1, "{:?}", cuts[0]);
         let cut = cuts[0][0];

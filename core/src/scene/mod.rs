@@ -336,7 +336,7 @@ fn build(
             CutPlane::around_window(w.normal, &triangles[range.start as usize..range.end as usize])
         })
         .collect();
-    let contacts = contacts::contact_cuts(&triangles, &surfaces);
+    let contacts = contacts::contact_cuts(&triangles, &surfaces, patches::CLUTTER * parsed.patch_size * parsed.patch_size);
     let patches = patches::subdivide(&triangles, &mut surfaces, &sizing, &clusterable, &window_planes, &contacts);
     let viewpoints = sensors::viewpoints(&parsed)?;
     let bounds = bounds(&triangles);

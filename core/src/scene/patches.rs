@@ -366,7 +366,7 @@ pub fn estimate(triangles: &[Triangle], surfaces: &[Surface], sizing: &PatchSizi
 }
 
 /// Surfaces smaller than this share of the allowed patch's area are clutter.
-const CLUTTER: f32 = 0.25;
+pub(crate) const CLUTTER: f32 = 0.25;
 
 /// The clusters of clutter: per surface, its cluster (index into the
 /// returned list of member lists), for the surfaces that `clusterable`
