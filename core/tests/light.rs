@@ -863,3 +863,47 @@ fn a_windowless_room_is_dark_though_its_floor_runs_on_outside() {
     // (single-precision ray tests). Without the cut, the room reads 386 lx.
     assert!(brightest < 1e-5 * terrace[0].total, "the closed room reads {brightest} lx");
 }
+
+/// The automatic first view looks into one room through its windows, even
+/// when one façade's windows (one window group) light several rooms: the
+/// eye is not put at the partition between them.
+#[test]
+fn the_first_view_looks_into_one_room() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("two_rooms");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut obj = quad_obj::QuadObj::new("room.mtl");
+    let (w, d, h) = (8.0, 6.0, 3.0);
+    obj.quad("floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
+    obj.quad("ceiling", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
+    obj.quad("wall", [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]]);
+    obj.quad("wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
+    obj.quad("wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
+    // The partition between the two rooms, at x = 4.
+    obj.quad("wall", [[4.0, 0.0, 0.0], [4.0, d, 0.0], [4.0, d, h], [4.0, 0.0, h]]);
+    // The south façade with a 2 × 1.4 m window in the middle of each room.
+    obj.quad("wall", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, 0.0, 0.9], [0.0, 0.0, 0.9]]);
+    obj.quad("wall", [[0.0, 0.0, 2.3], [w, 0.0, 2.3], [w, 0.0, h], [0.0, 0.0, h]]);
+    for (a, b) in [(0.0, 1.0), (3.0, 5.0), (7.0, w)] {
+        obj.quad("wall", [[a, 0.0, 0.9], [b, 0.0, 0.9], [b, 0.0, 2.3], [a, 0.0, 2.3]]);
+    }
+    for x in [1.0, 5.0] {
+        obj.quad("glass", [[x, 0.0, 0.9], [x + 2.0, 0.0, 0.9], [x + 2.0, 0.0, 2.3], [x, 0.0, 2.3]]);
+    }
+    std::fs::write(dir.join("room.obj"), obj.text()).unwrap();
+    std::fs::write(
+        dir.join("room.mtl"),
+        "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl ceiling\nKd 0.8 0.8 0.8\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.12\n",
+    )
+    .unwrap();
+    let scene = "name = \"Two rooms\"\n[site]\nlatitude = 40.78\nlongitude = -73.97\ntimezone = -5.0\n[model]\nobj = \"room.obj\"\n";
+    std::fs::write(dir.join("scene.toml"), scene).unwrap();
+    let scene = load(&dir.join("scene.toml"));
+    let model = LightModel::unlit(scene.clone());
+    assert_eq!(model.windows.groups.len(), 1, "both windows face south: one group");
+    let view = model.interior_view().unwrap();
+    println!("eye {}, target {}", view.eye, view.target);
+    let room = |x: f32| x > 4.0;
+    assert!((view.eye.x - 4.0).abs() > 0.3, "the eye stands at the partition: {}", view.eye);
+    assert_eq!(room(view.eye.x), room(view.target.x), "the eye looks into the other room: {} → {}", view.eye, view.target);
+    assert!((view.target.x - 2.0).abs() < 0.1 || (view.target.x - 6.0).abs() < 0.1, "the target is one room's window: {}", view.target);
+}

@@ -83,19 +83,54 @@ fn outward_normal(tracer: &Tracer, window: &Window) -> (DVec3, bool) {
 
 /// Eye height above the floor for an automatic view, m.
 const EYE_HEIGHT: f32 = 1.5;
+/// Windows of a group closer than this (m, centre to centre) light one
+/// room, for the automatic view.
+const WINDOW_CLUSTER: f32 = 2.5;
+
+/// The windows `windows` (indices into [`Scene::windows`]) in clusters:
+/// chains of windows whose centres lie within [`WINDOW_CLUSTER`].
+fn clusters(scene: &Scene, windows: &[u32]) -> Vec<Vec<u32>> {
+    let mut clusters: Vec<Vec<u32>> = Vec::new();
+    for &w in windows {
+        let near = |c: &Vec<u32>| {
+            c.iter().any(|&o| scene.windows[o as usize].centroid.distance(scene.windows[w as usize].centroid) < WINDOW_CLUSTER)
+        };
+        let mut joined: Vec<u32> = vec![w];
+        clusters.retain(|c| {
+            if near(c) {
+                joined.extend(c);
+                false
+            } else {
+                true
+            }
+        });
+        clusters.push(joined);
+    }
+    clusters
+}
 
 impl super::LightModel {
-    /// A view from inside the room behind the largest group of vertical
-    /// windows, looking out through them: the eye at eye height in the back
-    /// corner (toward the far wall, then toward a side wall), looking at the
+    /// A view from inside the room behind the largest cluster of vertical
+    /// windows (windows of one group within [`WINDOW_CLUSTER`] of each
+    /// other: a group spans a whole façade, its middle may be a partition),
+    /// looking out through them: the eye at eye height in the back corner
+    /// (toward the far wall, then toward a side wall), looking at the
     /// windows' middle a metre above the floor, so the floor's sun patches
-    /// and the windows are both in view. `None` without vertical windows.
+    /// and the windows are both in view. `None` without vertical windows
+    /// that see the sky.
     pub fn interior_view(&self) -> Option<crate::scene::Viewpoint> {
         let scene = &self.scene;
-        let area = |g: &WindowGroup| g.windows.iter().map(|&w| scene.windows[w as usize].area).sum::<f32>();
-        let group = self.windows.groups.iter().filter(|g| g.outward.z.abs() < 0.7).max_by(|a, b| area(a).total_cmp(&area(b)))?;
-        let centre = group.windows.iter().map(|&w| scene.windows[w as usize].centroid * scene.windows[w as usize].area).sum::<glam::Vec3>()
-            / area(group);
+        let area = |cluster: &[u32]| cluster.iter().map(|&w| scene.windows[w as usize].area).sum::<f32>();
+        let cluster = self
+            .windows
+            .groups
+            .iter()
+            .filter(|g| g.outward.z.abs() < 0.7 && !g.enclosed)
+            .flat_map(|g| clusters(scene, &g.windows).into_iter().map(move |c| (g, c)))
+            .max_by(|a, b| area(&a.1).total_cmp(&area(&b.1)));
+        let (group, cluster) = cluster?;
+        let centre = cluster.iter().map(|&w| scene.windows[w as usize].centroid * scene.windows[w as usize].area).sum::<glam::Vec3>()
+            / area(&cluster);
         let inward = -glam::Vec3::new(group.outward.x as f32, group.outward.y as f32, 0.0).normalize();
         let across = inward.cross(glam::Vec3::Z);
         // How far a ray goes from `from` along `direction` before a surface (`fallback` if none).
