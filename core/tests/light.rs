@@ -745,11 +745,7 @@ fn room_in_a_thick_wall(dir: &Path, split: bool) -> PathBuf {
     let mut obj = quad_obj::QuadObj::new("room.mtl");
     let (w, d, h, t) = (4.0, 6.0, 3.0, 0.4);
     let (x0, x1, z0, z1, glass) = (1.0, 3.0, 0.9, 2.3, -0.2);
-    obj.quad("floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
-    obj.quad("ceiling", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
-    obj.quad("wall", [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]]);
-    obj.quad("wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
-    obj.quad("wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
+    room_on_ground::room_open_to_south(&mut obj, w, d, h);
     // The south wall's inner (y = 0) and outer (y = −t) faces, around the hole.
     for y in [0.0, -t] {
         obj.quad("wall", [[0.0, y, 0.0], [w, y, 0.0], [w, y, z0], [0.0, y, z0]]);
@@ -873,11 +869,7 @@ fn the_first_view_looks_into_one_room() {
     std::fs::create_dir_all(&dir).unwrap();
     let mut obj = quad_obj::QuadObj::new("room.mtl");
     let (w, d, h) = (8.0, 6.0, 3.0);
-    obj.quad("floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
-    obj.quad("ceiling", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
-    obj.quad("wall", [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]]);
-    obj.quad("wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
-    obj.quad("wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
+    room_on_ground::room_open_to_south(&mut obj, w, d, h);
     // The partition between the two rooms, at x = 4.
     obj.quad("wall", [[4.0, 0.0, 0.0], [4.0, d, 0.0], [4.0, d, h], [4.0, 0.0, h]]);
     // The south façade with a 2 × 1.4 m window in the middle of each room.

@@ -23,11 +23,7 @@ pub fn room_on_a_ground(dir: &Path, width: f64, depth: f64, adaptive: bool) -> P
             [2.0 - width / 2.0, 3.0 + depth / 2.0, -0.1],
         ],
     );
-    obj.quad("floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
-    obj.quad("ceiling", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
-    obj.quad("wall", [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]]);
-    obj.quad("wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
-    obj.quad("wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
+    room_open_to_south(&mut obj, w, d, h);
     obj.quad("wall", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, 0.0, 0.9], [0.0, 0.0, 0.9]]);
     obj.quad("wall", [[0.0, 0.0, 2.3], [w, 0.0, 2.3], [w, 0.0, h], [0.0, 0.0, h]]);
     obj.quad("wall", [[0.0, 0.0, 0.9], [1.0, 0.0, 0.9], [1.0, 0.0, 2.3], [0.0, 0.0, 2.3]]);
@@ -42,4 +38,16 @@ pub fn room_on_a_ground(dir: &Path, width: f64, depth: f64, adaptive: bool) -> P
     );
     std::fs::write(dir.join("scene.toml"), scene).unwrap();
     dir.join("scene.toml")
+}
+
+/// A `w` × `d` × `h` m room from the origin, x east, y north, z up, into
+/// `obj`: its floor, ceiling and north, west and east walls (materials
+/// "floor", "ceiling", "wall"), facing in; the south side (y = 0) is left
+/// for the caller's façade.
+pub fn room_open_to_south(obj: &mut QuadObj, w: f64, d: f64, h: f64) {
+    obj.quad("floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
+    obj.quad("ceiling", [[0.0, 0.0, h], [0.0, d, h], [w, d, h], [w, 0.0, h]]);
+    obj.quad("wall", [[0.0, d, 0.0], [w, d, 0.0], [w, d, h], [0.0, d, h]]);
+    obj.quad("wall", [[0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, d, h], [0.0, 0.0, h]]);
+    obj.quad("wall", [[w, d, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [w, d, h]]);
 }

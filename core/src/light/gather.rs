@@ -254,8 +254,8 @@ impl LightModel {
     /// reflectance: a sweep may change it), glass and panels' outer sides
     /// do not.
     ///
-    /// The sky through a window the side sees from afar (farther than twice
-    /// the window's size and the patch's) comes from rays aimed at the
+    /// The sky through a window the side sees from afar (farther than the
+    /// window's size and the patch's) comes from rays aimed at the
     /// window instead ([`LightSettings::window_rays_per_patch`]): points on
     /// the windows drawn by their solid angle from the patch, each ray
     /// weighted by cos·cos·A/(π r² P). The hemisphere rays' sky through
@@ -286,12 +286,13 @@ impl LightModel {
         // The windows seen from afar, with the odds of aiming at each.
         let centre = patch.centroid.as_dvec3();
         let reach = patch.area.sqrt() as f64 * std::f64::consts::SQRT_2;
+        let rays = self.settings.window_rays_per_patch;
         let mut aimed: Vec<(usize, f64)> = Vec::new();
-        for (k, target) in targets.iter().enumerate() {
+        for (k, target) in targets.iter().enumerate().filter(|_| rays > 0) {
             let to = target.centroid - centre;
             let distance = to.length();
             let cos_here = normal.dot(to) / distance;
-            if self.settings.window_rays_per_patch > 0 && distance > 1.0 * target.size.max(reach) && cos_here > 0.1 {
+            if distance > target.size.max(reach) && cos_here > 0.1 {
                 let cos_there = target.normal.dot(to / distance).abs().max(0.1);
                 aimed.push((k, target.area * cos_here * cos_there / (distance * distance)));
             }
@@ -303,7 +304,6 @@ impl LightModel {
         let is_aimed = |key: u32| SkyKey::unpack(key, bins).window.is_some_and(|w| aimed.iter().any(|&(k, _)| targets[k].window == w));
         coefficients.retain(|&(key, _)| !is_aimed(key));
         let odds_total: f64 = aimed.iter().map(|a| a.1).sum();
-        let rays = self.settings.window_rays_per_patch;
         let (mut through, mut ignored) = (Vec::new(), Vec::new());
         for j in 0..rays {
             // Stratified over the windows by their odds.
@@ -344,10 +344,7 @@ impl LightModel {
             .map(|(k, window)| {
                 let range = scene.surfaces[window.surface as usize].triangles.clone();
                 let triangles = &scene.triangles[range.start as usize..range.end as usize];
-                let (lo, hi) = triangles
-                    .iter()
-                    .flat_map(|t| t.vertices)
-                    .fold((glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+                let (lo, hi) = crate::scene::bounds(triangles);
                 WindowTarget {
                     window: k as u32,
                     triangles: with_cumulative_areas(triangles.iter().map(|t| t.vertices)),

@@ -89,7 +89,7 @@ const WINDOW_CLUSTER: f32 = 2.5;
 
 /// The windows `windows` (indices into [`Scene::windows`]) in clusters:
 /// chains of windows whose centres lie within [`WINDOW_CLUSTER`].
-fn clusters(scene: &Scene, windows: &[u32]) -> Vec<Vec<u32>> {
+fn window_clusters(scene: &Scene, windows: &[u32]) -> Vec<Vec<u32>> {
     let mut clusters: Vec<Vec<u32>> = Vec::new();
     for &w in windows {
         let near = |c: &Vec<u32>| {
@@ -126,7 +126,7 @@ impl super::LightModel {
             .groups
             .iter()
             .filter(|g| g.outward.z.abs() < 0.7 && !g.enclosed)
-            .flat_map(|g| clusters(scene, &g.windows).into_iter().map(move |c| (g, c)))
+            .flat_map(|g| window_clusters(scene, &g.windows).into_iter().map(move |c| (g, c)))
             .max_by(|a, b| area(&a.1).total_cmp(&area(&b.1)));
         let (group, cluster) = cluster?;
         let centre = cluster.iter().map(|&w| scene.windows[w as usize].centroid * scene.windows[w as usize].area).sum::<glam::Vec3>()

@@ -12,7 +12,8 @@ use std::collections::HashMap;
 
 use glam::{IVec3, Vec2, Vec3};
 
-use super::patches::{CutPlane, IN_PLANE, bounds_of};
+use super::bounds;
+use super::patches::{CutPlane, IN_PLANE};
 use super::{Surface, Triangle};
 
 /// A surface takes at most this many contact planes (the longest contacts).
@@ -42,7 +43,7 @@ pub fn contact_cuts(triangles: &[Triangle], surfaces: &[Surface], min_area: f32)
         .map(|surface| {
             let own = surface.triangles.start as usize..surface.triangles.end as usize;
             let tris = &triangles[own.clone()];
-            let (lo, hi) = bounds_of(tris);
+            let (lo, hi) = bounds(tris);
             let flat = Flat::new(surface.normal, tris);
             let mut cuts: Vec<(CutPlane, f32)> = Vec::new();
             for t in grid.near(lo - Vec3::splat(IN_PLANE), hi + Vec3::splat(IN_PLANE)) {
@@ -146,7 +147,7 @@ impl Grid {
     fn new(triangles: &[Triangle], keep: &[bool]) -> Self {
         let mut grid = Grid { cells: HashMap::new(), large: Vec::new() };
         for (t, triangle) in triangles.iter().enumerate().filter(|(t, _)| keep[*t]) {
-            let (lo, hi) = bounds_of(std::slice::from_ref(triangle));
+            let (lo, hi) = bounds(std::slice::from_ref(triangle));
             let (a, b) = (cell(lo - Vec3::splat(IN_PLANE)), cell(hi + Vec3::splat(IN_PLANE)));
             let span = (b - a + IVec3::ONE).as_i64vec3();
             if span.x * span.y * span.z > MAX_CELLS {

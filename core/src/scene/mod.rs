@@ -363,7 +363,8 @@ fn build(
     })
 }
 
-fn bounds(triangles: &[Triangle]) -> (Vec3, Vec3) {
+/// The box (min, max) around `triangles`.
+pub(crate) fn bounds(triangles: &[Triangle]) -> (Vec3, Vec3) {
     triangles
         .iter()
         .flat_map(|t| t.vertices)

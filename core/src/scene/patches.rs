@@ -165,7 +165,7 @@ impl CutPlane {
     /// The plane of a window made of `triangles`, with unit `normal`,
     /// cutting within [`NEAR_WINDOW`] of it.
     pub fn around_window(normal: Vec3, triangles: &[Triangle]) -> Self {
-        let (lo, hi) = bounds_of(triangles);
+        let (lo, hi) = super::bounds(triangles);
         let points = triangles.iter().flat_map(|t| t.vertices);
         let count = (3 * triangles.len()).max(1) as f32;
         let offset = points.map(|p| p.dot(normal)).sum::<f32>() / count;
@@ -187,11 +187,6 @@ impl CutPlane {
         let heights = || tris.iter().flat_map(|t| t.vertices).map(|p| self.height(p));
         self.is_near(bounds) && heights().any(|h| h > IN_PLANE) && heights().any(|h| h < -IN_PLANE)
     }
-}
-
-/// The box around `tris`.
-pub(crate) fn bounds_of(tris: &[Triangle]) -> (Vec3, Vec3) {
-    tris.iter().flat_map(|t| t.vertices).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)))
 }
 
 /// Splits a convex `polygon` by `planes` (at most 64), handing each part to
@@ -391,7 +386,7 @@ fn clusters(
         if !clusterable[index] || surface.area >= CLUTTER * allowed * allowed {
             continue;
         }
-        let bounds = bounds_of(tris);
+        let bounds = super::bounds(tris);
         if cuts.iter().any(|c| c.cuts(tris, bounds)) {
             continue;
         }
@@ -444,9 +439,9 @@ pub fn subdivide(
         let tree = Quadtree::for_surface(sizing, surface, tris);
         let (u, v) = (tree.u, tree.v);
         let cell_of = |p: Vec3| tree.cell_of(p);
-        let bounds = bounds_of(tris);
+        let bounds = super::bounds(tris);
         let planes: Vec<&CutPlane> = cuts.iter().filter(|c| c.cuts(tris, bounds)).chain(&contacts[index]).collect();
-        // Per leaf cell and side of the window planes: its pieces.
+        // Per leaf cell and side of the cutting planes: its pieces.
         let mut cells: BTreeMap<(i64, i64, u64), Vec<[Vec3; 3]>> = BTreeMap::new();
         let mut add = |cell: Cell, polygon: Vec<Vec3>| {
             split_by_planes(polygon, &planes, &mut |above, part| {
