@@ -71,9 +71,10 @@ impl Openings {
     pub(super) fn ways_into_sphere(&self, centre: DVec3, radius: f64, beams: &[SunBeam]) -> Vec<WayIn> {
         let mut ways = Vec::new();
         for (b, beam) in beams.iter().enumerate() {
+            let ray = Ray::new(beam.to_light);
             for (w, ([min, max], group)) in self.windows.iter().enumerate() {
-                if *group == beam.panel_group && ray_meets_box(centre, beam.to_light, *min - radius, *max + radius) {
-                    ways.push(WayIn { beam: b as u32, window: w as u32 });
+                if *group == beam.panel_group && ray.meets_box(centre, *min - radius, *max + radius) {
+                    ways.push(WayIn { beam: b as u32, window: w as u32, ray });
                 }
             }
         }
@@ -83,13 +84,13 @@ impl Openings {
     /// The beams (indices, ascending, each once) that may reach a point of a
     /// patch by one of its `ways` in; the others cannot. No allocation: it
     /// runs for every traced point.
-    pub(super) fn beams_reaching<'a>(&'a self, point: DVec3, ways: &'a [WayIn], beams: &'a [SunBeam]) -> impl Iterator<Item = usize> + 'a {
+    pub(super) fn beams_reaching<'a>(&'a self, point: DVec3, ways: &'a [WayIn]) -> impl Iterator<Item = usize> + 'a {
         // Ways come beam by beam: a beam already let through skips its other windows.
         let mut last = None;
         ways.iter().filter_map(move |way| {
             let beam = way.beam as usize;
             let [min, max] = self.windows[way.window as usize].0;
-            let through = last != Some(beam) && ray_meets_box(point, beams[beam].to_light, min, max);
+            let through = last != Some(beam) && way.ray.meets_box(point, min, max);
             through.then(|| {
                 last = Some(beam);
                 beam
@@ -103,24 +104,48 @@ impl Openings {
 pub(super) struct WayIn {
     beam: u32,
     window: u32,
+    /// Toward the beam's light.
+    ray: Ray,
 }
 
-/// Whether the ray from `origin` along `direction` (t ≥ 0) meets the box.
-fn ray_meets_box(origin: DVec3, direction: DVec3, min: DVec3, max: DVec3) -> bool {
-    let (mut enter, mut exit) = (0.0_f64, f64::INFINITY);
-    for axis in 0..3 {
-        let (o, d) = (origin[axis], direction[axis]);
-        if d.abs() < 1e-12 {
-            if o < min[axis] || o > max[axis] {
-                return false;
-            }
-            continue;
-        }
-        let (a, b) = ((min[axis] - o) / d, (max[axis] - o) / d);
-        enter = enter.max(a.min(b));
-        exit = exit.min(a.max(b));
+/// A direction of rays with its reciprocal kept: the box test runs for
+/// every traced point, and multiplies where it would divide.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Ray {
+    direction: DVec3,
+    /// 1 / direction, per axis (unused where the direction lies along the axis's plane).
+    reciprocal: DVec3,
+}
+
+impl Ray {
+    fn new(direction: DVec3) -> Self {
+        Self { direction, reciprocal: direction.recip() }
     }
-    enter <= exit
+
+    /// Whether the ray from `origin` (t ≥ 0) meets the box.
+    fn meets_box(&self, origin: DVec3, min: DVec3, max: DVec3) -> bool {
+        let (mut enter, mut exit) = (0.0_f64, f64::INFINITY);
+        for axis in 0..3 {
+            let o = origin[axis];
+            if self.direction[axis].abs() < 1e-12 {
+                if o < min[axis] || o > max[axis] {
+                    return false;
+                }
+                continue;
+            }
+            let r = self.reciprocal[axis];
+            let (a, b) = ((min[axis] - o) * r, (max[axis] - o) * r);
+            // No NaN here (the direction is off the axis's plane): plain comparisons.
+            let (near, far) = if a < b { (a, b) } else { (b, a) };
+            if near > enter {
+                enter = near;
+            }
+            if far < exit {
+                exit = far;
+            }
+        }
+        enter <= exit
+    }
 }
 
 #[cfg(test)]
@@ -130,11 +155,12 @@ mod tests {
     #[test]
     fn rays_meet_boxes_ahead_of_them_only() {
         let (min, max) = (DVec3::new(0.0, 0.0, 1.0), DVec3::new(1.0, 1.0, 1.0));
-        assert!(ray_meets_box(DVec3::new(0.5, 0.5, 0.0), DVec3::Z, min, max));
-        assert!(!ray_meets_box(DVec3::new(0.5, 0.5, 0.0), -DVec3::Z, min, max));
-        assert!(!ray_meets_box(DVec3::new(1.5, 0.5, 0.0), DVec3::Z, min, max));
-        let slanted = DVec3::new(1.0, 0.0, 1.0).normalize();
-        assert!(ray_meets_box(DVec3::new(-0.5, 0.5, 0.0), slanted, min, max));
-        assert!(!ray_meets_box(DVec3::new(-1.5, 0.5, 0.0), slanted, min, max));
+        let (up, down) = (Ray::new(DVec3::Z), Ray::new(-DVec3::Z));
+        assert!(up.meets_box(DVec3::new(0.5, 0.5, 0.0), min, max));
+        assert!(!down.meets_box(DVec3::new(0.5, 0.5, 0.0), min, max));
+        assert!(!up.meets_box(DVec3::new(1.5, 0.5, 0.0), min, max));
+        let slanted = Ray::new(DVec3::new(1.0, 0.0, 1.0).normalize());
+        assert!(slanted.meets_box(DVec3::new(-0.5, 0.5, 0.0), min, max));
+        assert!(!slanted.meets_box(DVec3::new(-1.5, 0.5, 0.0), min, max));
     }
 }

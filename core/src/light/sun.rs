@@ -43,7 +43,7 @@ impl LightModel {
             Reach::Open => self.beams_irradiance(point, normal, beams),
             Reach::Through(ways) => {
                 let (origin, sun) = (point + normal * SURFACE_OFFSET, beams[0].to_light);
-                self.openings.beams_reaching(point, ways, beams).map(|b| self.beam_irradiance(origin, normal, &beams[b], sun)).sum()
+                self.openings.beams_reaching(point, ways).map(|b| self.beam_irradiance(origin, normal, &beams[b], sun)).sum()
             }
         }
     }
