@@ -49,7 +49,8 @@ fn bench(c: &mut Criterion) {
         let coefficients = model.sensor_coefficients();
         let folded = start.elapsed() - gathered;
         let sun_dir = cache.join("sun-only");
-        let sun_hours = SunHours::cached(&model, &coefficients, &scene.site, false, &sun_dir, &|_| {});
+        let hours = AnnualOptions::default().hours_with_sun(&weather);
+        let sun_hours = SunHours::cached(&model, &coefficients, &scene.site, false, &hours, &sun_dir, &|_| {});
         let traced = start.elapsed() - gathered - folded;
         drop((coefficients, sun_hours));
         let _ = std::fs::remove_dir_all(&sun_dir);

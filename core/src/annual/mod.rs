@@ -13,18 +13,21 @@
 //! 3. Before the first hour, every sensor's radiosity adjoint is solved once
 //!    and folded into coefficients ([`crate::light::coefficients`]): per
 //!    sky bin (and panel group) and per patch side's sun beams. The year's
-//!    sun is traced once per sun-up hour of the calendar ([`SunHours`]): the
-//!    direct sun (shadow rays through glass and along panel lobes) and its
-//!    first bounce where the sensors' rays land, exactly; the later bounces
-//!    from a sun path of 2.5° nodes. Sun positions follow the site, not the
+//!    sun is traced once per hour whose sun the study reads (sun up, direct
+//!    normal irradiance, occupied or kept hourly:
+//!    [`AnnualOptions::hours_with_sun`]; [`SunHours`]): the direct sun
+//!    (shadow rays through glass and along panel lobes) and its first
+//!    bounce where the sensors' rays land, exactly; the later bounces from
+//!    a sun path of 2.5° nodes. Sun positions follow the site, not the
 //!    weather, and the light is linear in the sun's strength, so the table
-//!    is kept in the light cache for every weather file of the site. A lit
-//!    hour is then one product of the coefficients with the hour's bin
+//!    is kept in the light cache for every weather file of the site whose
+//!    sunny hours it holds. A lit hour is then one product of the coefficients with the hour's bin
 //!    radiances plus the table's row times the hour's direct normal
 //!    irradiance: no ray, no radiosity solve. Runs of whole days go in
 //!    parallel; hours are independent, so the numbers do not depend on the
-//!    thread count; occupied hours are counted as they come. The table
-//!    (sensors × sun-up hours: 5.4 MB for the office's 150 sensors) is
+//!    thread count; occupied hours are counted as they come (the others
+//!    are not read unless every hour is kept). The table (sensors × traced
+//!    hours: 3.9 MB for the office's 150 sensors and Chicago's year) is
 //!    written as it is traced and read back an hour at a time, never held
 //!    whole; with no cache folder, or past [`MAX_TABLE_BYTES`] on disk,
 //!    the sun is traced hour by hour instead. Memory follows sensors × sky
@@ -271,12 +274,27 @@ pub struct AnnualOptions<'a> {
     /// The year's sun on the model at the site, when the caller has it
     /// ([`SunHours::cached`]); made by the run otherwise (through
     /// `sun_cache`). With shades
-    /// studied it must keep the shade groups' sun.
+    /// studied it must keep the shade groups' sun, and it must hold the
+    /// study's [`Self::hours_with_sun`].
     pub sun_hours: Option<&'a SunHours>,
     /// Where the run keeps the year's sun and the sensor coefficients it
     /// makes (the light cache folder), so the next year of the same scene
     /// and site reads them; `None`: made for this run only.
     pub sun_cache: Option<&'a std::path::Path>,
+}
+
+impl AnnualOptions<'_> {
+    /// The hours of `weather`'s year whose sun the study reads (one per
+    /// hour): lit, with direct normal irradiance, and occupied, or any such
+    /// hour when every hour is kept. The year's sun is traced for these
+    /// alone.
+    pub fn hours_with_sun(&self, weather: &Weather) -> Vec<bool> {
+        weather
+            .hours
+            .iter()
+            .map(|h| h.direct_normal > 0.0 && h.diffuse_horizontal > 0.0 && (self.keep_hourly || self.occupancy.contains(h.hour)))
+            .collect()
+    }
 }
 
 /// Runs the year. With `options.shades`, every occupied hour lowers the
@@ -313,21 +331,22 @@ pub fn annual(
         return Err(format!("{} shade groups: at most 16 are studied together", groups));
     }
     // Tracing the year's sun, when it falls to us, is most of the work.
+    let with_sun = options.hours_with_sun(weather);
     let own_table;
     let year_sun = match options.sun_hours {
         Some(table) if !table.fits(model, site, shades.is_some()) => {
             return Err("the year's sun was traced for another scene, site or shade study".into());
         }
+        Some(table) if !table.holds(&with_sun) => return Err("the year's sun was traced for other hours than this study reads".into()),
         Some(table) => YearSun::Table(table),
-        None => match options
-            .sun_cache
-            .and_then(|dir| SunHours::cached(model, coefficients, site, shades.is_some(), dir, &|done| progress(SUN_TRACING_SHARE * done)))
-        {
+        None => match options.sun_cache.and_then(|dir| {
+            SunHours::cached(model, coefficients, site, shades.is_some(), &with_sun, dir, &|done| progress(SUN_TRACING_SHARE * done))
+        }) {
             Some((table, _)) => {
                 own_table = table;
                 YearSun::Table(&own_table)
             }
-            None => YearSun::traced(model, coefficients, site, shades.is_some()),
+            None => YearSun::traced(model, coefficients, site, shades.is_some(), &with_sun),
         },
     };
     let tracing_share = if options.sun_hours.is_none() && matches!(year_sun, YearSun::Table(_)) { SUN_TRACING_SHARE } else { 0.0 };
@@ -341,7 +360,7 @@ pub fn annual(
     // light with each combination that occurs: a model, its coefficients
     // and its sun path around the suns of the hours it reads.
     let down: Vec<u32> = par_map(None, HOURS, |k| match lit(k) {
-        Some(sky) if groups > 0 && occupancy.contains(weather.hours[k].hour) => {
+        Some(sky) if groups > 0 && with_sun[k] && occupancy.contains(weather.hours[k].hour) => {
             Ok(shades_down(model, year_sun.through_shades(k)?.as_deref(), sky))
         }
         _ => Ok(0),
@@ -376,7 +395,8 @@ pub fn annual(
     // sensor; `None` when the hour is dark.
     let readings = |k: usize| -> Result<Option<Vec<(f64, f64)>>, String> {
         let Some(sky) = lit(k) else { return Ok(None) };
-        let open = coefficients.readings_with_sun(model, sky, year_sun.response(k)?.as_ref(), Some(1));
+        let sun = if with_sun[k] { year_sun.response(k)? } else { None };
+        let open = coefficients.readings_with_sun(model, sky, sun.as_ref(), Some(1));
         Ok(Some(match shaded.iter().find(|(mask, ..)| *mask == down[k]) {
             Some((_, shaded_model, coefficients, path)) => {
                 let lowered = coefficients.readings_on_path(shaded_model, sky, path, Some(1));
@@ -391,8 +411,9 @@ pub fn annual(
         for k in run * days / runs * 24..(run + 1) * days / runs * 24 {
             let hour = &weather.hours[k];
             tally.skipped += usize::from(skies[k].is_err());
-            let readings = readings(k)?;
-            if occupancy.contains(hour.hour) {
+            let occupied = occupancy.contains(hour.hour);
+            let readings = if occupied || keep_hourly { readings(k)? } else { None };
+            if occupied {
                 tally.count(readings.as_deref(), down[k] != 0);
             }
             if keep_hourly {

@@ -1,17 +1,23 @@
 //! The year's sun on a scene at its site, traced once: for every hour of the
-//! 365-day calendar with the sun up, each sensor's direct sun and
-//! interreflected sun per W/m² of direct normal irradiance
-//! ([`SunResponse`]), and, when shades are studied, the direct sun through
-//! each shade group's windows.
+//! 365-day calendar a study reads the sun of (the sun up, with direct
+//! normal irradiance in the weather, in the occupied hours or every hour
+//! when hourly values are kept: [`super::AnnualOptions::hours_with_sun`]),
+//! each sensor's direct sun and interreflected sun per W/m² of direct
+//! normal irradiance ([`SunResponse`]), and, when shades are studied, the
+//! direct sun through each shade group's windows.
 //!
 //! Sun positions follow the site and the calendar, not the weather (the
 //! EPW gives how strong the sun is, not where it is), and the light is
-//! linear in the sun's strength: so one table serves every weather file of
-//! the site, and an hour of the year is a product with no ray traced. The
-//! table is stored in the light cache beside the scene's precomputation
-//! ([`SunHours::cached`]), keyed by what it depends on beyond it: every
-//! material's light (reflectances, glass, panel keys), the site, the shade
-//! groups.
+//! linear in the sun's strength: so an hour of the year is a product with
+//! no ray traced, and a table serves every weather file of the site whose
+//! sunny hours it holds. Hours nobody reads are not traced: an overcast
+//! hour's sun, a night office's (a quarter of the sun-up hours of Chicago's
+//! year with the default occupancy). The table is stored in the light
+//! cache beside the scene's precomputation ([`SunHours::cached`]), keyed by
+//! what it depends on beyond it: every material's light (reflectances,
+//! glass, panel keys), the site, the shade groups. A study that reads
+//! hours the stored table lacks traces again, the hours of both, so two
+//! weather files of one site settle on one table.
 
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -29,7 +35,7 @@ use crate::sun::{direction_from_angles, solar_position};
 use crate::weather::{HOURS, calendar};
 
 /// Bump when the table or how it is traced changes.
-const FORMAT: u32 = 2;
+const FORMAT: u32 = 3;
 
 /// The most a table may take on disk, bytes. Past it (a grid of tens of
 /// thousands of sensors) the year's sun is traced hour by hour instead
@@ -40,34 +46,54 @@ pub const MAX_TABLE_BYTES: usize = 256 << 20;
 /// sensors × these hours (about five days), not the year.
 const HOURS_PER_BATCH: usize = 64;
 
-/// The sun's light at every sensor for each sun-up hour of the year, kept
+/// The sun's light at every sensor for each traced hour of the year, kept
 /// in a file of the light cache and read an hour at a time: memory follows
 /// the sensors, not the hours.
 ///
 /// The file's payload: sensors, shade groups and rows (`u32` each), each
-/// hour's row (`u32::MAX` with the sun down), then the rows, each the
-/// sensors' direct sun, their interreflected sun and the direct sun through
-/// each shade group's windows (`f32`, lux per W/m² of direct normal
-/// irradiance).
+/// hour's row ([`SUN_DOWN`], [`NOT_TRACED`] or the row's index), then the
+/// rows, each the sensors' direct sun, their interreflected sun and the
+/// direct sun through each shade group's windows (`f32`, lux per W/m² of
+/// direct normal irradiance).
 pub struct SunHours {
     /// What the table was traced for ([`Self::key`]).
     key: u64,
     sensors: usize,
     /// Shade groups whose windows' direct sun is kept (0 when not studied).
     shade_groups: usize,
-    /// Each hour's row in the file, `None` when the sun is down.
-    row_of_hour: Vec<Option<u32>>,
+    /// Each hour of the year's row in the file.
+    row_of_hour: Vec<HourRow>,
     file: StreamedReader,
 }
+
+/// What the table holds of an hour.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum HourRow {
+    /// Traced: the sun was down.
+    SunDown,
+    /// Not traced: no study read it yet.
+    NotTraced,
+    /// Traced, in this row of the file.
+    Row(u32),
+}
+
+/// An hour's word in the file with the sun down.
+const SUN_DOWN: u32 = u32::MAX;
+/// An hour's word in the file when it was not traced.
+const NOT_TRACED: u32 = u32::MAX - 1;
+
+/// Why a stored table was traced again.
+const LACKS_HOURS: &str = "it lacks hours of sun this study reads";
 
 /// Where the rows start in the payload.
 const ROWS_AT: u64 = 4 * (3 + HOURS as u64);
 
 impl SunHours {
     /// The year's sun of `model` at `site` (`shades`: with each shade
-    /// group's direct sun) from the light cache in `dir`, traced and stored
-    /// there first when it is not; `progress` hears the share of the hours
-    /// traced (from any thread). `None` when the table would take more than
+    /// group's direct sun) in the `hours` of the year a study reads, from
+    /// the light cache in `dir`, traced and stored there first when it is
+    /// not; `progress` hears the share of the hours traced (from any
+    /// thread). `None` when the table would take more than
     /// [`MAX_TABLE_BYTES`] or cannot be stored: the year then traces its
     /// sun hour by hour ([`YearSun::Traced`], the same numbers).
     pub fn cached(
@@ -75,44 +101,60 @@ impl SunHours {
         coefficients: &SensorCoefficients,
         site: &Site,
         shades: bool,
+        hours: &[bool],
         dir: &Path,
         progress: &(dyn Fn(f64) + Sync),
     ) -> Option<(Self, CacheOutcome)> {
-        let suns = sun_directions(site);
         let shade_groups = if shades { model.scene.shades.len() } else { 0 };
-        let sun_up = suns.iter().flatten().count();
-        if model.scene.sensors.len() * (2 + shade_groups) * sun_up * size_of::<f32>() > MAX_TABLE_BYTES {
+        let row_bytes = model.scene.sensors.len() * (2 + shade_groups) * size_of::<f32>();
+        let fits = |suns: &[Option<Option<DVec3>>]| suns.iter().flatten().flatten().count() * row_bytes <= MAX_TABLE_BYTES;
+        if !fits(&sun_directions(site, hours)) {
             return None;
         }
         let key = Self::key(model, site, shades);
+        // The hours a stored table holds that this study does not read: traced again with ours.
+        let stored_hours = std::cell::RefCell::new(vec![false; HOURS]);
         cache::through_streamed_cache(
             dir,
             &format!("{key:016x}-sun-hours"),
             key,
-            |file| Self::open(file, key, model, shades),
-            |out| Self::trace(model, coefficients, site, &suns, shade_groups, out, progress),
+            |file| {
+                let table = Self::open(file, key, model, shades).ok_or(cache::DOES_NOT_FIT)?;
+                if table.holds(hours) {
+                    return Ok(table);
+                }
+                *stored_hours.borrow_mut() = table.row_of_hour.iter().map(|row| *row != HourRow::NotTraced).collect();
+                Err(LACKS_HOURS.to_string())
+            },
+            |out| {
+                let both: Vec<bool> = hours.iter().zip(stored_hours.borrow().iter()).map(|(ours, stored)| *ours || *stored).collect();
+                let suns = Some(sun_directions(site, &both)).filter(|suns| fits(suns)).unwrap_or_else(|| sun_directions(site, hours));
+                Self::trace(model, coefficients, site, &suns, shade_groups, out, progress)
+            },
         )
     }
 
-    /// Traces every sun-up hour of `suns` (one per hour of the year) into
-    /// `out`, a batch of hours at a time.
+    /// Traces the sun-up hours of `suns` (one per hour of the year, `None`
+    /// where not traced, `Some(None)` with the sun down) into `out`, a batch
+    /// of hours at a time.
     fn trace(
         model: &LightModel,
         coefficients: &SensorCoefficients,
         site: &Site,
-        suns: &[Option<DVec3>],
+        suns: &[Option<Option<DVec3>>],
         shade_groups: usize,
         out: &mut StreamedWriter,
         progress: &(dyn Fn(f64) + Sync),
     ) -> std::io::Result<()> {
-        let up: Vec<DVec3> = suns.iter().flatten().copied().collect();
+        let up: Vec<DVec3> = suns.iter().flatten().flatten().copied().collect();
         let mut next = 0;
         let row_of_hour = suns.iter().map(|d| match d {
-            Some(_) => {
+            Some(Some(_)) => {
                 next += 1;
                 next - 1
             }
-            None => u32::MAX,
+            Some(None) => SUN_DOWN,
+            None => NOT_TRACED,
         });
         let counts = [model.scene.sensors.len(), shade_groups, up.len()].map(|n| n as u32);
         out.append(&counts.into_iter().chain(row_of_hour).flat_map(u32::to_le_bytes).collect::<Vec<u8>>())?;
@@ -146,8 +188,9 @@ impl SunHours {
         let row_of_hour = words[3..]
             .iter()
             .map(|&row| match row {
-                u32::MAX => Some(None),
-                row if (row as usize) < row_count => Some(Some(row)),
+                SUN_DOWN => Some(HourRow::SunDown),
+                NOT_TRACED => Some(HourRow::NotTraced),
+                row if (row as usize) < row_count => Some(HourRow::Row(row)),
                 _ => None,
             })
             .collect::<Option<Vec<_>>>()?;
@@ -188,8 +231,14 @@ impl SunHours {
         self.key == Self::key(model, site, shades) && self.sensors == model.scene.sensors.len()
     }
 
+    /// Whether every hour of `hours` (one per hour of the year) was traced.
+    pub fn holds(&self, hours: &[bool]) -> bool {
+        self.row_of_hour.iter().zip(hours).all(|(row, &read)| !read || *row != HourRow::NotTraced)
+    }
+
     /// Hour `k`'s response (hour of the 365-day year), `Ok(None)` with the
-    /// sun down; an error when the file cannot be read.
+    /// sun down; an error when the hour was not traced or the file cannot
+    /// be read.
     pub fn response(&self, k: usize) -> Result<Option<SunResponse>, String> {
         Ok(self.read_row(k, 0..2 * self.sensors)?.map(|mut direct| {
             let interreflected = direct.split_off(self.sensors);
@@ -205,7 +254,11 @@ impl SunHours {
 
     /// The values `range` of hour `k`'s row.
     fn read_row(&self, k: usize, range: std::ops::Range<usize>) -> Result<Option<Vec<f32>>, String> {
-        let Some(row) = self.row_of_hour.get(k).copied().flatten() else { return Ok(None) };
+        let row = match self.row_of_hour.get(k) {
+            Some(HourRow::Row(row)) => *row,
+            Some(HourRow::SunDown) => return Ok(None),
+            Some(HourRow::NotTraced) | None => return Err(format!("hour {k} of the year's sun was not traced")),
+        };
         let row_values = (2 + self.shade_groups) * self.sensors;
         let offset = ROWS_AT + ((row as usize * row_values + range.start) * size_of::<f32>()) as u64;
         let mut bytes = vec![0u8; range.len() * size_of::<f32>()];
@@ -222,16 +275,23 @@ pub(super) enum YearSun<'a> {
         model: &'a LightModel,
         coefficients: &'a SensorCoefficients,
         site: &'a Site,
-        /// The sun's later bounces around every sun-up hour.
+        /// The sun's later bounces around every hour it may be asked for.
         path: SunPath,
         shade_groups: usize,
     },
 }
 
 impl<'a> YearSun<'a> {
-    /// Hour by hour: the sun path of the year at `site`.
-    pub(super) fn traced(model: &'a LightModel, coefficients: &'a SensorCoefficients, site: &'a Site, shades: bool) -> Self {
-        let up: Vec<DVec3> = sun_directions(site).into_iter().flatten().collect();
+    /// Hour by hour: the sun path around the sun of the `hours` of the
+    /// year at `site` (the only hours it may be asked for).
+    pub(super) fn traced(
+        model: &'a LightModel,
+        coefficients: &'a SensorCoefficients,
+        site: &'a Site,
+        shades: bool,
+        hours: &[bool],
+    ) -> Self {
+        let up: Vec<DVec3> = sun_directions(site, hours).into_iter().flatten().flatten().collect();
         let path = SunPath::new(model, coefficients, site, &up, None);
         let shade_groups = if shades { model.scene.shades.len() } else { 0 };
         YearSun::Traced { model, coefficients, site, path, shade_groups }
@@ -259,9 +319,11 @@ impl<'a> YearSun<'a> {
     }
 }
 
-/// The sun's direction at the middle of every hour of the year ([`sun_direction`]).
-fn sun_directions(site: &Site) -> Vec<Option<DVec3>> {
-    par_map(None, HOURS, |k| sun_direction(site, k))
+/// The sun's direction at the middle of every hour of the year among
+/// `hours` ([`sun_direction`]; `Some(None)` with the sun down), `None` for
+/// the others.
+fn sun_directions(site: &Site, hours: &[bool]) -> Vec<Option<Option<DVec3>>> {
+    par_map(None, HOURS, |k| hours[k].then(|| sun_direction(site, k)))
 }
 
 /// The sun's direction in the model's frame at the middle of hour `k` of the
@@ -304,22 +366,31 @@ mod tests {
     use crate::light::LightSettings;
     use crate::panel::PanelCatalog;
 
+    /// The bundled test room lit, its sensor coefficients, its site and an
+    /// empty cache folder named for the test.
+    fn test_room(test: &str) -> (LightModel, SensorCoefficients, Site, std::path::PathBuf) {
+        let scene = crate::scene::load_scene(&crate::bundled_scene("test_room"), &PanelCatalog::new()).unwrap().scene;
+        let site = scene.site;
+        let model = LightModel::precompute(Arc::new(scene), LightSettings::default()).unwrap();
+        let coefficients = model.sensor_coefficients();
+        let dir = std::env::temp_dir().join(format!("heliodon-sun-hours-{test}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        (model, coefficients, site, dir)
+    }
+
     /// Traced hour by hour (where no table is kept) the year's sun is the
     /// cached table's, hour for hour; the table written and the same table
     /// read back are one.
     #[test]
     fn hours_traced_one_by_one_are_the_tables() {
-        let scene = crate::scene::load_scene(&crate::bundled_scene("test_room"), &PanelCatalog::new()).unwrap().scene;
-        let site = scene.site;
-        let model = LightModel::precompute(Arc::new(scene), LightSettings::default()).unwrap();
-        let coefficients = model.sensor_coefficients();
-        let dir = std::env::temp_dir().join(format!("heliodon-sun-hours-unit-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        let (written, outcome) = SunHours::cached(&model, &coefficients, &site, false, &dir, &|_| {}).expect("a small table is kept");
+        let (model, coefficients, site, dir) = test_room("unit");
+        let every = [true; HOURS];
+        let (written, outcome) =
+            SunHours::cached(&model, &coefficients, &site, false, &every, &dir, &|_| {}).expect("a small table is kept");
         assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");
-        let (read, outcome) = SunHours::cached(&model, &coefficients, &site, false, &dir, &|_| {}).expect("a small table is kept");
+        let (read, outcome) = SunHours::cached(&model, &coefficients, &site, false, &every, &dir, &|_| {}).expect("a small table is kept");
         assert!(matches!(outcome, CacheOutcome::Hit(_)), "{outcome:?}");
-        let traced = YearSun::traced(&model, &coefficients, &site, false);
+        let traced = YearSun::traced(&model, &coefficients, &site, false, &every);
         let mut lit = 0;
         for k in (0..HOURS).step_by(97) {
             let from_table = written.response(k).unwrap();
@@ -328,6 +399,33 @@ mod tests {
             lit += usize::from(from_table.is_some_and(|r| r.direct.iter().any(|&e| e > 0.0)));
         }
         assert!(lit > 10, "{lit} sunny hours compared");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A table holds the hours it was traced for: a study reading others
+    /// traces again, keeping the hours of both, with the same numbers; an
+    /// hour nobody asked for is an error, never a dark hour.
+    #[test]
+    fn a_table_traced_for_some_hours_is_traced_again_for_more_and_keeps_both() {
+        let (model, coefficients, site, dir) = test_room("union");
+        let month = |m: u32| -> Vec<bool> { (0..HOURS).map(|k| calendar(k).0 == m).collect() };
+        let (january, july) = (month(1), month(7));
+        let cached = |hours: &[bool]| SunHours::cached(&model, &coefficients, &site, false, hours, &dir, &|_| {}).expect("kept");
+        let (first, outcome) = cached(&january);
+        assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");
+        assert!(first.holds(&january) && !first.holds(&july));
+        let noon_in = |m: u32| (0..HOURS).find(|&k| calendar(k) == (m, 15, 13)).unwrap();
+        assert!(first.response(noon_in(7)).is_err(), "an hour not traced is not read as dark");
+        let (both, outcome) = cached(&july);
+        assert!(matches!(&outcome, CacheOutcome::Rebuilt(_, why) if why == LACKS_HOURS), "{outcome:?}");
+        assert!(both.holds(&january) && both.holds(&july));
+        let (_, outcome) = cached(&january);
+        assert!(matches!(outcome, CacheOutcome::Hit(_)), "{outcome:?}");
+        for k in (0..HOURS).filter(|&k| january[k]) {
+            assert_eq!(first.response(k).unwrap(), both.response(k).unwrap(), "hour {k}");
+        }
+        let july_noon = both.response(noon_in(7)).unwrap().expect("the sun is up at a July noon");
+        assert!(july_noon.direct.iter().chain(&july_noon.interreflected).any(|&e| e > 0.0));
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

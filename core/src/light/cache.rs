@@ -198,15 +198,16 @@ pub fn through_cache<T>(
 }
 
 /// [`through_cache`] for a file too big to hold in memory: loaded in place
-/// ([`StreamedReader`]) when it is whole and `load` accepts it, else
-/// written by `write` as it is made ([`StreamedWriter`]) and loaded from
-/// what was written. `None` when it can be neither loaded nor stored (the
-/// caller then does without the file).
+/// ([`StreamedReader`]) when it is whole and `load` accepts it (else `load`
+/// says why not), else written by `write` as it is made
+/// ([`StreamedWriter`]) and loaded from what was written. `None` when it
+/// can be neither loaded nor stored (the caller then does without the
+/// file).
 pub(crate) fn through_streamed_cache<T>(
     dir: &Path,
     name: &str,
     key: u64,
-    load: impl Fn(StreamedReader) -> Option<T>,
+    load: impl Fn(StreamedReader) -> Result<T, String>,
     write: impl FnOnce(&mut StreamedWriter) -> io::Result<()>,
 ) -> Option<(T, CacheOutcome)> {
     let path = file_path(dir, name);
@@ -214,17 +215,17 @@ pub(crate) fn through_streamed_cache<T>(
     let rebuilt = match StreamedReader::open(&path, key) {
         None => None,
         Some(Ok(file)) => match load(file) {
-            Some(value) => {
+            Ok(value) => {
                 mark_used(&path);
                 return Some((value, CacheOutcome::Hit(path)));
             }
-            None => Some(DOES_NOT_FIT.to_string()),
+            Err(why) => Some(why),
         },
         Some(Err(why)) => Some(why),
     };
     let mut out = StreamedWriter::create(&path, key).ok()?;
     write(&mut out).ok()?;
-    let value = load(out.finish().ok()?)?;
+    let value = load(out.finish().ok()?).ok()?;
     tidy(dir, &path, size_limit());
     let outcome = match rebuilt {
         Some(why) => CacheOutcome::Rebuilt(path, why),
@@ -234,7 +235,7 @@ pub(crate) fn through_streamed_cache<T>(
 }
 
 /// Why a whole file was not used: what it holds is for another scene.
-const DOES_NOT_FIT: &str = "its contents do not fit the scene";
+pub(crate) const DOES_NOT_FIT: &str = "its contents do not fit the scene";
 
 /// Used now: the last file to be evicted.
 fn mark_used(path: &Path) {
