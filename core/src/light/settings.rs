@@ -29,7 +29,9 @@ pub struct LightSettings {
     /// 1/n of a side's beam: at 64 an hour read between sun positions (the
     /// annual sun path) stays within 2% of one traced at it, where 16 gave
     /// 2.6% (the office); relights cost little more (enclosed sides are
-    /// mostly spared by the openings).
+    /// mostly spared by the openings). The sun path's nodes give these to
+    /// the sides that matter to the sensors, fewer to the others
+    /// (`SensorCoefficients::path_sun_samples`).
     pub sun_samples_per_patch: usize,
     /// Points per side of an area sensor's grid for the direct sun (sky and
     /// indirect use a 4 × 4 grid).

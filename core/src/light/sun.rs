@@ -105,20 +105,19 @@ impl LightModel {
         panels::sun_beams(&self.panel_groups, sun)
     }
 
-    /// The beams on every diffuse patch side: shadow rays from
-    /// `sun_samples_per_patch` seeded points of each side that faces a beam
-    /// and that a beam may reach; only the sides `wanted` when given
-    /// (`threads` as [`par_map`]).
-    pub(super) fn sun_on_sides(&self, beams: &[SunBeam], wanted: Option<&[bool]>, threads: Option<usize>) -> SidesSun {
+    /// The beams on every diffuse patch side: shadow rays from `samples(side)`
+    /// seeded points of each side (0: not traced) that faces a beam and
+    /// that a beam may reach (`threads` as [`par_map`]).
+    pub(super) fn sun_on_sides(&self, beams: &[SunBeam], samples: &(dyn Fn(usize) -> usize + Sync), threads: Option<usize>) -> SidesSun {
         let patches = &self.scene.patches.patches;
         let sides: Vec<(f64, Reach)> = par_map(threads, patches.len() * 2, |side| {
-            let reach = self.side_reach(side, beams, wanted);
+            let n = samples(side);
+            let reach = if n == 0 { Reach::None } else { self.side_reach(side, beams, None) };
             if reach == Reach::None {
                 return (0.0, reach);
             }
             let triangles = self.patch_triangles(side / 2);
             let mut rng = Rng::new(3, side as u64);
-            let n = self.settings.sun_samples_per_patch;
             let normal = self.side_normal(side as u32);
             let total: f64 =
                 (0..n).map(|_| sample_area(&triangles, &mut rng)).map(|point| self.reaching_irradiance(&reach, point, normal, beams)).sum();
