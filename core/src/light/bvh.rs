@@ -61,12 +61,12 @@ impl Tracer {
             .then(|| Hit { patch: self.owner[self.bvh.primitive_indices[hit.primitive_id as usize] as usize], distance: f64::from(hit.t) })
     }
 
-    /// Every surface along a ray beyond `t_min`, in no particular order, until
-    /// `visit` returns false: one traversal for shadow rays through glass,
-    /// which stops at the first opaque surface.
-    pub fn each_hit(&self, origin: DVec3, direction: DVec3, t_min: f64, mut visit: impl FnMut(Hit) -> bool) {
+    /// Every surface along a ray between `t_min` and `t_max`, in no
+    /// particular order, until `visit` returns false: one traversal for
+    /// shadow rays through glass, which stops at the first opaque surface.
+    pub fn each_hit(&self, origin: DVec3, direction: DVec3, t_min: f64, t_max: f64, mut visit: impl FnMut(Hit) -> bool) {
         let direction = direction + DVec3::ZERO;
-        let ray = Ray::new(to_bvh(origin), to_bvh(direction), t_min as f32, f32::INFINITY);
+        let ray = Ray::new(to_bvh(origin), to_bvh(direction), t_min as f32, t_max as f32);
         let mut state = self.bvh.new_traversal(ray.direction);
         let mut node;
         'traversal: {

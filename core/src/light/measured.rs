@@ -30,7 +30,7 @@ use glam::DVec3;
 
 use super::panels::SunBeam;
 use super::sampling::{Rng, point_on_triangle};
-use super::{LightModel, MAX_GLASS_DEPTH, SURFACE_OFFSET, Surface};
+use super::{LightModel, SURFACE_OFFSET, Surface};
 
 /// Points a panel group's windows are sampled at, in all.
 const WINDOW_SAMPLES: usize = 4096;
@@ -148,22 +148,19 @@ impl LightModel {
 
     /// Where a ray from `origin` along `direction` meets a window of panel
     /// group `group`, and the glass it crosses on the way; `None` when
-    /// something else stops it first.
+    /// something else stops it first. The nearest of the group's window
+    /// triangles along the ray, then one bounded traversal for what lies
+    /// before it (a closest-hit search per pane cost most of a panel
+    /// room's year).
     pub(super) fn reaches_panel(&self, origin: DVec3, direction: DVec3, group: u32) -> Option<(DVec3, f64)> {
-        let (mut from, mut transmittance) = (origin, 1.0);
-        for _ in 0..=MAX_GLASS_DEPTH {
-            let hit = self.shadow_tracer.closest(from, direction, 1e-6)?;
-            let at = from + direction * hit.distance;
-            match self.surface_kind(hit.patch) {
-                Surface::Panel(g) if g == group => return Some((at, transmittance)),
-                Surface::Glass(glass) => {
-                    transmittance *= glass.at(direction.dot(self.scene.surfaces[hit.patch as usize].normal.as_dvec3())).0
-                }
-                _ => return None,
-            }
-            from = at + direction * SURFACE_OFFSET;
-        }
-        None
+        let distance = (self.panel_windows[group as usize].iter())
+            .filter_map(|triangle| ray_meets_triangle(origin, direction, triangle))
+            .filter(|&t| t > 1e-6)
+            .min_by(f64::total_cmp)?;
+        // What lies within a hair of the pane (its frame, a coplanar glass) does not stop the ray.
+        let before = distance * (1.0 - 1e-6) - 1e-5;
+        let transmittance = self.through_glass(origin, direction, before, |kind| matches!(kind, Surface::Panel(g) if g == group))?;
+        Some((origin + direction * distance, transmittance))
     }
 
     /// The sun on every measured panel group for `beams` (the first is the
@@ -216,5 +213,41 @@ impl LightModel {
             }
         }
         by_window
+    }
+}
+
+/// Where the line from `origin` along unit `direction` meets `triangle`
+/// (Möller–Trumbore), as a signed distance (negative: behind the origin);
+/// `None` when it misses.
+fn ray_meets_triangle(origin: DVec3, direction: DVec3, [a, b, c]: &[DVec3; 3]) -> Option<f64> {
+    let (e1, e2) = (*b - *a, *c - *a);
+    let p = direction.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < 1e-12 {
+        return None;
+    }
+    let to_origin = origin - *a;
+    let u = to_origin.dot(p) / det;
+    let q = to_origin.cross(e1);
+    let v = direction.dot(q) / det;
+    ((0.0..=1.0).contains(&u) && v >= 0.0 && u + v <= 1.0).then(|| e2.dot(q) / det)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A ray meets a triangle ahead of it, at its distance; one beside it
+    /// does not, and one behind it only at a negative distance.
+    #[test]
+    fn rays_meet_triangles_ahead_of_them() {
+        let triangle = [DVec3::new(0.0, 0.0, 2.0), DVec3::new(1.0, 0.0, 2.0), DVec3::new(0.0, 1.0, 2.0)];
+        let t = ray_meets_triangle(DVec3::new(0.2, 0.2, 0.0), DVec3::Z, &triangle).expect("straight up through it");
+        assert!((t - 2.0).abs() < 1e-12, "{t}");
+        assert!(ray_meets_triangle(DVec3::new(0.8, 0.8, 0.0), DVec3::Z, &triangle).is_none(), "beside its long edge");
+        assert!(ray_meets_triangle(DVec3::new(0.2, 0.2, 0.0), -DVec3::Z, &triangle).is_none_or(|t| t < 0.0), "behind it");
+        let slanted = DVec3::new(0.1, 0.1, 1.0).normalize();
+        let t = ray_meets_triangle(DVec3::new(0.1, 0.1, 0.0), slanted, &triangle).unwrap();
+        assert!((t * slanted.z - 2.0).abs() < 1e-12, "{t}");
     }
 }

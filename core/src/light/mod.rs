@@ -104,6 +104,8 @@ pub struct LightModel {
     /// Panel windows by material and orientation, and each surface's group.
     panel_groups: Vec<panels::PanelGroup>,
     group_of_surface: Vec<Option<u32>>,
+    /// Per panel group, its windows' triangles.
+    panel_windows: Vec<Vec<[DVec3; 3]>>,
     /// Per panel group, points on its windows (sensors' direct sun through
     /// measured panels, [`measured`]).
     panel_samples: Vec<measured::WindowSamples>,
@@ -244,6 +246,14 @@ impl LightModel {
             .collect();
         let windows = WindowGroups::new(&scene, &tracer);
         let (panel_groups, group_of_surface) = panels::panel_groups(&scene, &windows);
+        let mut panel_windows = vec![Vec::new(); panel_groups.len()];
+        for window in &scene.windows {
+            if let Some(group) = group_of_surface[window.surface as usize] {
+                let range = scene.surfaces[window.surface as usize].triangles.clone();
+                let triangles = scene.triangles[range.start as usize..range.end as usize].iter().map(|t| t.vertices.map(|v| v.as_dvec3()));
+                panel_windows[group as usize].extend(triangles);
+            }
+        }
         let openings = openings::Openings::new(&scene, &group_of_surface);
         let mut window_of_surface = vec![None; scene.surfaces.len()];
         for (k, window) in scene.windows.iter().enumerate() {
@@ -255,6 +265,7 @@ impl LightModel {
             window_of_surface,
             panel_groups,
             group_of_surface,
+            panel_windows,
             panel_samples: Vec::new(),
             openings,
             scene,

@@ -59,30 +59,37 @@ impl LightModel {
     }
 
     /// How much of the sun reaches `point` (through glass; 0 when blocked).
-    /// The product of the glass crossed does not depend on their order, so
-    /// one traversal visits them all and stops at the first opaque surface.
     pub(super) fn sun_transmittance(&self, point: DVec3, sun: DVec3) -> f64 {
-        let mut transmittance = 1.0;
+        self.through_glass(point, sun, f64::INFINITY, |_| false).unwrap_or(0.0)
+    }
+
+    /// The product of the glass a ray crosses before `t_max`; `None` when
+    /// anything else stops it first, but what `passes` lets through. The
+    /// product does not depend on the order of the panes, so one traversal
+    /// visits them all and stops at the first stop.
+    pub(super) fn through_glass(&self, origin: DVec3, direction: DVec3, t_max: f64, passes: impl Fn(Surface) -> bool) -> Option<f64> {
+        let mut transmittance = Some(1.0);
         // Glass surfaces crossed, by distance: a ray through the edge between
         // two triangles of one surface meets it twice.
         // (A few at most: kept on the stack, shadow rays are many.)
         let mut crossed = [(u32::MAX, 0.0); 16];
         let mut count = 0;
-        self.shadow_tracer.each_hit(point, sun, 1e-6, |hit| {
+        self.shadow_tracer.each_hit(origin, direction, 1e-6, t_max, |hit| {
             let (surface, normal) = (hit.patch, self.scene.surfaces[hit.patch as usize].normal);
             match self.surface_kind(surface) {
-                // Through a panel the sun arrives only along its lobes.
-                Surface::Diffuse(_) | Surface::Panel(_) => {
-                    transmittance = 0.0;
-                    false
-                }
                 Surface::Glass(glass) => {
                     if !crossed[..count].iter().any(|&(s, d)| s == surface && (d - hit.distance).abs() < 1e-5) {
                         crossed[count.min(15)] = (surface, hit.distance);
                         count = (count + 1).min(16);
-                        transmittance *= glass.at(sun.dot(normal.as_dvec3())).0;
+                        transmittance = transmittance.map(|t| t * glass.at(direction.dot(normal.as_dvec3())).0);
                     }
                     true
+                }
+                kind if passes(kind) => true,
+                // Through a panel the sun arrives only along its lobes.
+                Surface::Diffuse(_) | Surface::Panel(_) => {
+                    transmittance = None;
+                    false
                 }
             }
         });
