@@ -21,9 +21,9 @@
 //!    a sun path of 2.5° nodes. Sun positions follow the site, not the
 //!    weather, and the light is linear in the sun's strength, so the table
 //!    is kept in the light cache for every weather file of the site whose
-//!    sunny hours it holds. A lit hour is then one product of the coefficients with the hour's bin
-//!    radiances plus the table's row times the hour's direct normal
-//!    irradiance: no ray, no radiosity solve. Runs of whole days go in
+//!    sunny hours it holds. A lit hour is then one product of the
+//!    coefficients with the hour's bin radiances plus the table's row times
+//!    the hour's direct normal irradiance: no ray, no radiosity solve. Runs of whole days go in
 //!    parallel; hours are independent, so the numbers do not depend on the
 //!    thread count; occupied hours are counted as they come (the others
 //!    are not read unless every hour is kept). The table (sensors × traced
