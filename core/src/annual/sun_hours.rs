@@ -108,7 +108,8 @@ impl SunHours {
         let shade_groups = if shades { model.scene.shades.len() } else { 0 };
         let row_bytes = model.scene.sensors.len() * (2 + shade_groups) * size_of::<f32>();
         let fits = |suns: &[Option<Option<DVec3>>]| suns.iter().flatten().flatten().count() * row_bytes <= MAX_TABLE_BYTES;
-        if !fits(&sun_directions(site, hours)) {
+        let ours = sun_directions(site, hours);
+        if !fits(&ours) {
             return None;
         }
         let key = Self::key(model, site, shades);
@@ -127,9 +128,10 @@ impl SunHours {
                 Err(LACKS_HOURS.to_string())
             },
             |out| {
+                // Our hours alone when the stored table adds none, or the union would not fit.
                 let both: Vec<bool> = hours.iter().zip(stored_hours.borrow().iter()).map(|(ours, stored)| *ours || *stored).collect();
-                let suns = Some(sun_directions(site, &both)).filter(|suns| fits(suns)).unwrap_or_else(|| sun_directions(site, hours));
-                Self::trace(model, coefficients, site, &suns, shade_groups, out, progress)
+                let both = (both != hours).then(|| sun_directions(site, &both)).filter(|suns| fits(suns));
+                Self::trace(model, coefficients, site, both.as_deref().unwrap_or(&ours), shade_groups, out, progress)
             },
         )
     }
@@ -257,7 +259,7 @@ impl SunHours {
         let row = match self.row_of_hour.get(k) {
             Some(HourRow::Row(row)) => *row,
             Some(HourRow::SunDown) => return Ok(None),
-            Some(HourRow::NotTraced) | None => return Err(format!("hour {k} of the year's sun was not traced")),
+            Some(HourRow::NotTraced) | None => return Err(not_traced(k)),
         };
         let row_values = (2 + self.shade_groups) * self.sensors;
         let offset = ROWS_AT + ((row as usize * row_values + range.start) * size_of::<f32>()) as u64;
@@ -277,6 +279,8 @@ pub(super) enum YearSun<'a> {
         site: &'a Site,
         /// The sun's later bounces around every hour it may be asked for.
         path: SunPath,
+        /// The hours it may be asked for.
+        hours: Vec<bool>,
         shade_groups: usize,
     },
 }
@@ -294,15 +298,16 @@ impl<'a> YearSun<'a> {
         let up: Vec<DVec3> = sun_directions(site, hours).into_iter().flatten().flatten().collect();
         let path = SunPath::new(model, coefficients, site, &up, None);
         let shade_groups = if shades { model.scene.shades.len() } else { 0 };
-        YearSun::Traced { model, coefficients, site, path, shade_groups }
+        YearSun::Traced { model, coefficients, site, path, hours: hours.to_vec(), shade_groups }
     }
 
-    /// Hour `k`'s response, `Ok(None)` with the sun down.
+    /// Hour `k`'s response, `Ok(None)` with the sun down; an error for an
+    /// hour it was not made for, as the table's.
     pub(super) fn response(&self, k: usize) -> Result<Option<SunResponse>, String> {
         match self {
             YearSun::Table(table) => table.response(k),
-            YearSun::Traced { model, coefficients, site, path, .. } => {
-                Ok(sun_direction(site, k).map(|sun| coefficients.sun_response(model, sun, path, Some(1))))
+            YearSun::Traced { model, coefficients, site, path, hours, .. } => {
+                Ok(traced_sun(site, hours, k)?.map(|sun| coefficients.sun_response(model, sun, path, Some(1))))
             }
         }
     }
@@ -312,11 +317,24 @@ impl<'a> YearSun<'a> {
     pub(super) fn through_shades(&self, k: usize) -> Result<Option<Vec<f32>>, String> {
         match self {
             YearSun::Table(table) => table.through_shades(k),
-            YearSun::Traced { model, site, shade_groups, .. } => {
-                Ok(sun_direction(site, k).map(|sun| through_shades(model, sun, *shade_groups)))
+            YearSun::Traced { model, site, hours, shade_groups, .. } => {
+                Ok(traced_sun(site, hours, k)?.map(|sun| through_shades(model, sun, *shade_groups)))
             }
         }
     }
+}
+
+/// Hour `k`'s sun direction (`None` when down) where `hours` holds it.
+fn traced_sun(site: &Site, hours: &[bool], k: usize) -> Result<Option<DVec3>, String> {
+    match hours.get(k) {
+        Some(true) => Ok(sun_direction(site, k)),
+        _ => Err(not_traced(k)),
+    }
+}
+
+/// Why hour `k` of the year's sun cannot be read.
+fn not_traced(k: usize) -> String {
+    format!("hour {k} of the year's sun was not traced")
 }
 
 /// The sun's direction at the middle of every hour of the year among
@@ -404,7 +422,8 @@ mod tests {
 
     /// A table holds the hours it was traced for: a study reading others
     /// traces again, keeping the hours of both, with the same numbers; an
-    /// hour nobody asked for is an error, never a dark hour.
+    /// hour nobody asked for is an error, never a dark hour, from the table
+    /// and from the year traced hour by hour alike.
     #[test]
     fn a_table_traced_for_some_hours_is_traced_again_for_more_and_keeps_both() {
         let (model, coefficients, site, dir) = test_room("union");
@@ -416,6 +435,9 @@ mod tests {
         assert!(first.holds(&january) && !first.holds(&july));
         let noon_in = |m: u32| (0..HOURS).find(|&k| calendar(k) == (m, 15, 13)).unwrap();
         assert!(first.response(noon_in(7)).is_err(), "an hour not traced is not read as dark");
+        let traced = YearSun::traced(&model, &coefficients, &site, false, &january);
+        assert!(traced.response(noon_in(7)).is_err(), "nor when the year's sun is traced hour by hour");
+        assert_eq!(traced.response(noon_in(1)).unwrap(), first.response(noon_in(1)).unwrap());
         let (both, outcome) = cached(&july);
         assert!(matches!(&outcome, CacheOutcome::Rebuilt(_, why) if why == LACKS_HOURS), "{outcome:?}");
         assert!(both.holds(&january) && both.holds(&july));
