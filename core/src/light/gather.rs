@@ -13,7 +13,7 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use super::bvh::Tracer;
-use super::sampling::{Rng, cosine_directions, point_on_triangle};
+use super::sampling::{self, Rng, cosine_directions, point_on_triangle};
 use super::{LightModel, LightSettings, MAX_GLASS_DEPTH, MIN_WEIGHT, SURFACE_OFFSET, Surface, par_map};
 use crate::scene::{Scene, Sensor};
 
@@ -95,6 +95,65 @@ struct WindowTarget {
     area: f64,
     /// The diagonal of its box, m.
     size: f64,
+}
+
+/// A window a patch side aims rays at, with the odds of picking it.
+struct Aim {
+    /// Index into the targets.
+    target: usize,
+    odds: f64,
+    /// Within the window's size or the patch's ([`WindowTarget::aim`]).
+    near: bool,
+}
+
+/// How far in front of a patch side (m) a vertex of a window must lie for
+/// the side to aim at it: a wall around its own window sees none of it.
+const WINDOW_IN_FRONT: f64 = 1e-4;
+
+impl WindowTarget {
+    /// A direction from `eye` toward the window and the solid angle its
+    /// pdf is one over. From afar, a point drawn on the window by area
+    /// (pdf r²/(A cos)); near it, where that weight would swing with 1/r²,
+    /// a direction drawn evenly over the solid angle of one of its
+    /// triangles, picked by solid angle with `within` (a stratified
+    /// uniform number). `None` where the window fills no solid angle.
+    fn aim(&self, eye: DVec3, near: bool, within: f64, rng: &mut Rng) -> Option<(DVec3, f64)> {
+        if !near {
+            let to = sample_area(&self.triangles, rng) - eye;
+            let r2 = to.length_squared();
+            let dir = to / r2.sqrt();
+            return Some((dir, self.area * self.normal.dot(dir).abs() / r2));
+        }
+        let solid_angles: Vec<f64> = self.triangles.iter().map(|t| sampling::solid_angle(eye, &t.0)).collect();
+        let total: f64 = solid_angles.iter().sum();
+        if total <= 0.0 {
+            return None;
+        }
+        let mut pick = within * total;
+        let (index, share) = solid_angles
+            .iter()
+            .enumerate()
+            .find(|&(_, &omega)| {
+                pick -= omega;
+                pick <= 0.0 && omega > 0.0
+            })
+            .map_or((solid_angles.len() - 1, 1.0), |(i, &omega)| (i, ((pick + omega) / omega).clamp(0.0, 1.0)));
+        Some((sampling::direction_in_triangle(eye, &self.triangles[index].0, share, rng.next_f64()), total))
+    }
+}
+
+/// What a followed ray met on its way to the sky.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Way {
+    /// The first window it crossed.
+    window: Option<u32>,
+    /// Whether glass turned it back on the way: a path the aimed rays
+    /// cannot draw, left to the hemisphere rays.
+    reflected: bool,
+}
+
+impl Way {
+    const START: Self = Self { window: None, reflected: false };
 }
 
 /// A ray that reached a diffuse patch side.
@@ -195,8 +254,8 @@ impl LightModel {
     }
 
     /// Follows a ray through glass, adding the sky bin it leaves by to
-    /// `coefficients` or the patch side it reaches to `hits`;
-    /// `window` is the first window it crossed.
+    /// `coefficients` where `keep_sky` takes its way, or the patch side it
+    /// reaches to `hits`.
     #[allow(clippy::too_many_arguments)]
     fn follow(
         &self,
@@ -204,17 +263,25 @@ impl LightModel {
         dir: DVec3,
         weight: f64,
         depth: u32,
-        window: Option<u32>,
+        way: Way,
+        keep_sky: &dyn Fn(Way) -> bool,
         coefficients: &mut Vec<(u32, f64)>,
         hits: &mut Vec<SideHit>,
     ) {
+        let Way { window, reflected } = way;
         match self.tracer.closest(origin, dir, 1e-6) {
-            None => coefficients.push((SkyKey { window, bin: self.sky_bins.sphere_bin(dir) as u32 }.pack(self.bin_count()), weight)),
+            None if keep_sky(way) => {
+                coefficients.push((SkyKey { window, bin: self.sky_bins.sphere_bin(dir) as u32 }.pack(self.bin_count()), weight))
+            }
+            None => {}
             Some(hit) => {
                 let normal = self.patch_normal(hit.patch);
                 let cos = dir.dot(normal);
                 let point = origin + dir * hit.distance;
-                let crossed = window.or(self.window_of_surface[self.scene.patches.patches[hit.patch as usize].surface as usize]);
+                let crossed = Way {
+                    window: window.or(self.window_of_surface[self.scene.patches.patches[hit.patch as usize].surface as usize]),
+                    reflected,
+                };
                 match self.surface_of_patch(hit.patch) {
                     Surface::Diffuse(_) => hits.push(SideHit { side: side_of(hit.patch, cos > 0.0), weight, point }),
                     Surface::Panel(group) if depth < MAX_GLASS_DEPTH => {
@@ -226,20 +293,23 @@ impl LightModel {
                             // see; what lies beyond is not seen through a panel.
                             hits.push(SideHit { side, weight, point });
                             let window = self.window_of_surface[self.scene.patches.patches[hit.patch as usize].surface as usize];
-                            let key = SkyKey { window, bin: self.sky_bins.sphere_bin(dir) as u32 };
-                            coefficients.push((key.pack(self.bin_count()), weight));
+                            if keep_sky(Way { window, reflected }) {
+                                let key = SkyKey { window, bin: self.sky_bins.sphere_bin(dir) as u32 };
+                                coefficients.push((key.pack(self.bin_count()), weight));
+                            }
                         } else {
-                            self.follow(point + dir * SURFACE_OFFSET, dir, weight, depth + 1, crossed, coefficients, hits)
+                            self.follow(point + dir * SURFACE_OFFSET, dir, weight, depth + 1, crossed, keep_sky, coefficients, hits)
                         }
                     }
                     Surface::Glass(glass) if depth < MAX_GLASS_DEPTH => {
                         let (t, r) = glass.at(cos);
                         if weight * t > MIN_WEIGHT {
-                            self.follow(point + dir * SURFACE_OFFSET, dir, weight * t, depth + 1, crossed, coefficients, hits);
+                            self.follow(point + dir * SURFACE_OFFSET, dir, weight * t, depth + 1, crossed, keep_sky, coefficients, hits);
                         }
                         if weight * r > MIN_WEIGHT {
-                            let reflected = dir - 2.0 * cos * normal;
-                            self.follow(point + reflected * SURFACE_OFFSET, reflected, weight * r, depth + 1, window, coefficients, hits);
+                            let turned = dir - 2.0 * cos * normal;
+                            let way = Way { window, reflected: true };
+                            self.follow(point + turned * SURFACE_OFFSET, turned, weight * r, depth + 1, way, keep_sky, coefficients, hits);
                         }
                     }
                     _ => {}
@@ -254,14 +324,13 @@ impl LightModel {
     /// reflectance: a sweep may change it), glass and panels' outer sides
     /// do not.
     ///
-    /// The sky through a window the side sees from afar (farther than the
-    /// window's size and the patch's) comes from rays aimed at the
-    /// window instead ([`LightSettings::window_rays_per_patch`]): points on
-    /// the windows drawn by their solid angle from the patch, each ray
-    /// weighted by cos·cos·A/(π r² P). The hemisphere rays' sky through
-    /// those windows is dropped, so every path to the sky is counted once,
-    /// by the first window it crosses; near windows keep the hemisphere
-    /// rays (aimed rays would be weighted by 1/r² there).
+    /// The sky through the windows the side sees comes from rays aimed at
+    /// them instead ([`LightSettings::window_rays_per_patch`]), each ray
+    /// weighted by cos·Ω/(π P) for the solid angle Ω its direction was
+    /// drawn from and the odds P of its window ([`WindowTarget::aim`]).
+    /// The hemisphere rays keep the sky only where no aimed ray could have
+    /// drawn its path (through a window not aimed at, or after glass
+    /// turned it back), so every path to the sky is counted once.
     fn gather_patch_side(&self, side: usize, targets: &[WindowTarget]) -> Gather {
         let patch_index = side / 2;
         let gathers = match self.surface_of_patch(patch_index as u32) {
@@ -275,63 +344,76 @@ impl LightModel {
         let patch = &self.scene.patches.patches[patch_index];
         let normal = patch.normal.as_dvec3() * if side % 2 == 1 { -1.0 } else { 1.0 };
         let triangles = self.patch_triangles(patch_index);
+        let aimed = self.windows_to_aim_at(patch, normal, targets);
+        let aimed_window = |w: u32| aimed.iter().any(|a| targets[a.target].window == w);
         let mut rng = Rng::new(1, side as u64);
         let hemisphere = self.settings.rays_per_patch;
         let directions = cosine_directions(normal, hemisphere, &mut rng);
         let (mut coefficients, mut hits) = (Vec::new(), Vec::new());
+        // The sky straight through an aimed-at window is the aimed rays'.
+        let not_aimed = |way: Way| way.reflected || !way.window.is_some_and(aimed_window);
         for dir in directions {
             let point = sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET;
-            self.follow(point, dir, 1.0, 0, None, &mut coefficients, &mut hits);
+            self.follow(point, dir, 1.0, 0, Way::START, &not_aimed, &mut coefficients, &mut hits);
         }
-        // The windows seen from afar, with the odds of aiming at each.
-        let centre = patch.centroid.as_dvec3();
-        let reach = patch.area.sqrt() as f64 * std::f64::consts::SQRT_2;
         let rays = self.settings.window_rays_per_patch;
-        let mut aimed: Vec<(usize, f64)> = Vec::new();
-        for (k, target) in targets.iter().enumerate().filter(|_| rays > 0) {
-            let to = target.centroid - centre;
-            let distance = to.length();
-            let cos_here = normal.dot(to) / distance;
-            if distance > target.size.max(reach) && cos_here > 0.1 {
-                let cos_there = target.normal.dot(to / distance).abs().max(0.1);
-                aimed.push((k, target.area * cos_here * cos_there / (distance * distance)));
-            }
-        }
-        if aimed.is_empty() {
-            return Gather::from_raw(coefficients, &hits, hemisphere);
-        }
-        let bins = self.bin_count();
-        let is_aimed = |key: u32| SkyKey::unpack(key, bins).window.is_some_and(|w| aimed.iter().any(|&(k, _)| targets[k].window == w));
-        coefficients.retain(|&(key, _)| !is_aimed(key));
-        let odds_total: f64 = aimed.iter().map(|a| a.1).sum();
-        let (mut through, mut ignored) = (Vec::new(), Vec::new());
-        for j in 0..rays {
-            // Stratified over the windows by their odds.
+        let odds_total: f64 = aimed.iter().map(|a| a.odds).sum();
+        let mut ignored = Vec::new();
+        for j in (0..rays).filter(|_| !aimed.is_empty()) {
+            // Stratified over the windows by their odds, and within a near
+            // window by the rest of the stratum.
             let mut pick = (j as f64 + rng.next_f64()) / rays as f64 * odds_total;
-            let &(k, odds) = aimed
+            let aim = aimed
                 .iter()
                 .find(|a| {
-                    pick -= a.1;
+                    pick -= a.odds;
                     pick <= 0.0
                 })
                 .unwrap_or(aimed.last().expect("aimed is not empty"));
-            let target = &targets[k];
+            let within = ((pick + aim.odds) / aim.odds).clamp(0.0, 1.0);
+            let target = &targets[aim.target];
             let point = sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET;
-            let to = sample_area(&target.triangles, &mut rng) - point;
-            let r2 = to.length_squared();
-            let dir = to / r2.sqrt();
+            let Some((dir, solid_angle)) = target.aim(point, aim.near, within, &mut rng) else { continue };
             let cos_here = normal.dot(dir);
             if cos_here <= 0.0 {
                 continue;
             }
-            let solid_angle = target.area * target.normal.dot(dir).abs() / r2;
-            let weight = cos_here * solid_angle / (std::f64::consts::PI * odds / odds_total) * hemisphere as f64 / rays as f64;
-            through.clear();
-            self.follow(point, dir, weight, 0, None, &mut through, &mut ignored);
+            let weight = cos_here * solid_angle / (std::f64::consts::PI * aim.odds / odds_total) * hemisphere as f64 / rays as f64;
+            let straight_through = |way: Way| !way.reflected && way.window == Some(target.window);
+            self.follow(point, dir, weight, 0, Way::START, &straight_through, &mut coefficients, &mut ignored);
             ignored.clear();
-            coefficients.extend(through.iter().filter(|&&(key, _)| SkyKey::unpack(key, bins).window == Some(target.window)));
         }
         Gather::from_raw(coefficients, &hits, hemisphere)
+    }
+
+    /// The windows a patch side sees, with the odds of aiming a ray at
+    /// each: seen from afar by their solid angle from the patch's centre,
+    /// near ones by the solid angle of their triangles, times the cosine
+    /// there (at least 0.1: the odds only spread the rays, and a window
+    /// seen at a grazing angle must keep some).
+    fn windows_to_aim_at(&self, patch: &crate::scene::Patch, normal: DVec3, targets: &[WindowTarget]) -> Vec<Aim> {
+        let centre = patch.centroid.as_dvec3();
+        let reach = f64::from(patch.area).sqrt() * std::f64::consts::SQRT_2;
+        let mut aimed = Vec::new();
+        for (k, target) in targets.iter().enumerate().filter(|_| self.settings.window_rays_per_patch > 0) {
+            // Seen from some point of the side: a vertex in front of its plane.
+            if !target.triangles.iter().flat_map(|t| t.0).any(|v| normal.dot(v - centre) > WINDOW_IN_FRONT) {
+                continue;
+            }
+            let to = target.centroid - centre;
+            let distance = to.length();
+            let cos_here = (normal.dot(to) / distance.max(f64::EPSILON)).max(0.1);
+            let near = distance <= target.size.max(reach);
+            let solid_angle = if near {
+                target.triangles.iter().map(|t| sampling::solid_angle(centre, &t.0)).sum()
+            } else {
+                target.area * target.normal.dot(to / distance).abs().max(0.1) / (distance * distance)
+            };
+            if solid_angle > 0.0 {
+                aimed.push(Aim { target: k, odds: solid_angle * cos_here, near });
+            }
+        }
+        aimed
     }
 
     /// The windows as targets of aimed rays.
@@ -378,7 +460,7 @@ impl LightModel {
         let mut trace = |count: usize, coefficients: &mut Vec<(u32, f64)>, hits: &mut Vec<SideHit>| {
             for &point in &points {
                 for dir in cosine_directions(normal, count, &mut rng) {
-                    self.follow(point, dir, 1.0, 0, None, coefficients, hits);
+                    self.follow(point, dir, 1.0, 0, Way::START, &|_| true, coefficients, hits);
                 }
             }
             count * points.len()

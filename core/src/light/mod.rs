@@ -10,7 +10,7 @@
 //!    reach a diffuse patch side (a form factor) or leave the model (a
 //!    daylight coefficient of a sky or ground bin, Reinhart MF:n above the
 //!    horizon and its mirror below); patch sides also aim rays at the
-//!    windows they see from afar, for a steadier sky. Cached on disk
+//!    windows they see, for a steadier sky. Cached on disk
 //!    ([`cache`]).
 //! 2. **Direct light** per sun and sky ([`LightModel::relight`]): direct sun
 //!    by shadow rays through windows and along panel lobes ([`sun`],

@@ -1,6 +1,7 @@
 //! Deterministic sampling: a small counter-based generator seeded per
 //! receiver (so results do not depend on thread count or order), stratified
-//! cosine-weighted hemisphere directions, and points on triangles.
+//! cosine-weighted hemisphere directions, points on triangles, and
+//! directions spread evenly over the solid angle a triangle fills.
 
 use glam::DVec3;
 
@@ -62,6 +63,39 @@ pub fn point_on_triangle(t: &[DVec3; 3], a: f64, b: f64) -> DVec3 {
     t[0] * (1.0 - s) + t[1] * (s * (1.0 - b)) + t[2] * (s * b)
 }
 
+/// The solid angle (sr) triangle `t` fills seen from `eye` (Van Oosterom
+/// and Strackee 1983), whichever side it is seen from.
+pub fn solid_angle(eye: DVec3, t: &[DVec3; 3]) -> f64 {
+    let [a, b, c] = t.map(|v| (v - eye).normalize_or_zero());
+    let det = a.dot(b.cross(c)).abs();
+    let denominator = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
+    2.0 * det.atan2(denominator)
+}
+
+/// A direction from `eye` toward triangle `t`, uniformly distributed over
+/// the solid angle it fills, from two uniform numbers (Arvo 1995,
+/// "Stratified sampling of spherical triangles"): the pdf is 1/Ω, so a
+/// near window is sampled without the 1/r² weights of points drawn on it.
+pub fn direction_in_triangle(eye: DVec3, t: &[DVec3; 3], u: f64, v: f64) -> DVec3 {
+    let [a, b, c] = t.map(|p| (p - eye).normalize());
+    // The spherical triangle's angle at A, and its area.
+    let corner = |at: DVec3, p: DVec3, q: DVec3| {
+        let (e, f) = (p - at * at.dot(p), q - at * at.dot(q));
+        e.normalize_or_zero().dot(f.normalize_or_zero()).clamp(-1.0, 1.0).acos()
+    };
+    let (alpha, beta, gamma) = (corner(a, b, c), corner(b, c, a), corner(c, a, b));
+    let area = alpha + beta + gamma - std::f64::consts::PI;
+    // The sub-triangle A B C' of area u·Ω: where C' lies on the arc A C.
+    let (s, t_) = (u * area - alpha).sin_cos();
+    let cos_c = a.dot(b);
+    let (p, q) = (t_ - alpha.cos(), s + alpha.sin() * cos_c);
+    let cos_ac = (((q * t_ - p * s) * alpha.cos() - q) / ((q * s + p * t_) * alpha.sin())).clamp(-1.0, 1.0);
+    let c_prime = a * cos_ac + (c - a * c.dot(a)).normalize_or_zero() * (1.0 - cos_ac * cos_ac).max(0.0).sqrt();
+    // Then along the arc from B toward C' by the share v of its cosine.
+    let z = 1.0 - v * (1.0 - c_prime.dot(b));
+    (b * z + (c_prime - b * c_prime.dot(b)).normalize_or_zero() * (1.0 - z * z).max(0.0).sqrt()).normalize()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -74,6 +108,35 @@ mod tests {
         // E[cos θ] under cosine weighting is 2/3.
         let mean = dirs.iter().map(|d| d.z).sum::<f64>() / dirs.len() as f64;
         assert!((mean - 2.0 / 3.0).abs() < 2e-3, "{mean}");
+    }
+
+    /// Directions drawn in a triangle's solid angle hit the triangle, and
+    /// fill each part of it by that part's solid angle (a near, oblique
+    /// triangle, where points drawn by area would crowd far from the eye).
+    #[test]
+    fn directions_in_a_triangle_spread_over_its_solid_angle() {
+        let eye = DVec3::new(0.1, -0.2, 0.0);
+        let t = [DVec3::new(-1.0, 0.3, 0.4), DVec3::new(2.0, 0.5, 0.2), DVec3::new(0.2, 1.5, 3.0)];
+        let (normal, mid) = ((t[1] - t[0]).cross(t[2] - t[0]).normalize(), (t[0] + t[1]) * 0.5);
+        // The part of the triangle on one side of its median from t[2].
+        let half = [t[0], mid, t[2]];
+        let (omega, omega_half) = (solid_angle(eye, &t), solid_angle(eye, &half));
+        let mut rng = Rng::new(5, 1);
+        let n = 20_000;
+        let mut in_half = 0;
+        for _ in 0..n {
+            let d = direction_in_triangle(eye, &t, rng.next_f64(), rng.next_f64());
+            let hit = eye + d * (t[0] - eye).dot(normal) / d.dot(normal);
+            let inside = |tri: &[DVec3; 3]| (0..3).all(|i| (tri[(i + 1) % 3] - tri[i]).cross(hit - tri[i]).dot(normal) >= -1e-9);
+            assert!(inside(&t), "{d} misses the triangle");
+            in_half += usize::from(inside(&half));
+        }
+        let share = in_half as f64 / n as f64;
+        let expected = omega_half / omega;
+        assert!((share - expected).abs() < 0.01, "{share} against {expected}");
+        // Seen from the eye, the two halves split the triangle's solid angle.
+        let other = solid_angle(eye, &[mid, t[1], t[2]]);
+        assert!((omega_half + other - omega).abs() < 1e-12);
     }
 
     #[test]

@@ -6,11 +6,11 @@
 pub struct LightSettings {
     /// Hemisphere rays from each side of each patch (form factors, sky coefficients).
     pub rays_per_patch: usize,
-    /// Rays from each patch side aimed at the windows it sees from afar
-    /// (next-event estimation of the sky through them, see
-    /// [`super::gather`]): a far, small window is a small solid angle that
-    /// hemisphere rays find by chance; aimed rays find it every time. 0:
-    /// hemisphere rays alone.
+    /// Rays from each patch side aimed at the windows it sees (next-event
+    /// estimation of the sky through them, see [`super::gather`]): a far,
+    /// small window is a small solid angle that hemisphere rays find by
+    /// chance, and a near one a bright part of the hemisphere they sample
+    /// unevenly; aimed rays find each every time. 0: hemisphere rays alone.
     pub window_rays_per_patch: usize,
     /// Hemisphere rays from each sensor point whose landings keep the
     /// sun's first bounce (traced there every relight and every hour of a
