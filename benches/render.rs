@@ -72,6 +72,7 @@ fn ready_app(scene: PathBuf, mode: RenderMode) -> (App, String) {
         when: Some(LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(10.0).unwrap() }),
         sky: Some(SkySpec::Clear { turbidity: 2.45 }),
         settings: RenderSettings { mode, ..Default::default() },
+        light: Default::default(),
         panels: Default::default(),
     };
     let mut app = offscreen_app(&request);

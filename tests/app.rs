@@ -124,6 +124,7 @@ fn render_smoke_test_draws_the_model() {
         when: None,
         sky: None,
         settings: Default::default(),
+        light: Default::default(),
         panels: Default::default(),
     };
     let image = offscreen::render(request).expect("render");
@@ -165,6 +166,7 @@ fn edges_are_smoothed_toward_a_supersampled_picture() {
         when: Some(LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(14.0).unwrap() }),
         sky: Some(SkySpec::Clear { turbidity: 2.45 }),
         settings: RenderSettings { exposure: Some(10.0), ..Default::default() },
+        light: Default::default(),
         panels: Default::default(),
     };
     let (width, height, k) = (320usize, 200usize, 4usize);
@@ -228,6 +230,7 @@ fn the_sky_drawn_around_the_model_is_the_sky_model() {
         when: Some(when),
         sky: Some(spec),
         settings: RenderSettings { exposure: Some(12.0), ..Default::default() },
+        light: Default::default(),
         panels: Default::default(),
     };
     let image = offscreen::render(request).expect("render");
@@ -263,6 +266,7 @@ fn office_picture(view: &Viewpoint, (year, month, day, hour): (i32, u32, u32, f6
         when: Some(LocalDateTime { date: Date::new(year, month, day).unwrap(), time: TimeOfDay::from_hours(hour).unwrap() }),
         sky: Some(SkySpec::Clear { turbidity: 2.45 }),
         settings,
+        light: Default::default(),
         panels: Default::default(),
     };
     offscreen::render(request).expect("render")
@@ -446,6 +450,7 @@ fn compare_direct_sun(path: &std::path::Path, view: &Viewpoint, date: &str, time
         when: Some(LocalDateTime { date: Date::parse(date).unwrap(), time: TimeOfDay::parse(time).unwrap() }),
         sky: Some(SkySpec::Clear { turbidity: 2.45 }),
         settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
+        light: Default::default(),
         panels: Default::default(),
     };
     let scene_name = path.parent().and_then(|p| p.file_name()).unwrap().to_string_lossy();

@@ -130,6 +130,11 @@ fn cli_errors_are_one_line_and_non_zero() {
     let Run { code, err, .. } = heliodon(&["info"], &scratch());
     assert_eq!(code, 2);
     assert_eq!(err.lines().count(), 1, "{err}");
+    let render = ["render", "assets/scenes/test_room/scene.toml", "--date", "2026-03-21", "--time", "12:00", "--out", "x.png"];
+    let Run { code, err, .. } = heliodon(&[&render[..], &["--quality", "0"]].concat(), &scratch());
+    assert_eq!(code, 2);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("--quality"), "{err}");
     // Warnings go to stderr and do not fail the command.
     let f = fixture("cli_warning", &scene_toml("\n[materials.marble]\nkind = \"diffuse\"\nreflectance = 0.7\n"), OBJ);
     let Run { code, err, .. } = heliodon(&["info", f.scene().to_str().unwrap()], &scratch());

@@ -409,6 +409,7 @@ fn panel_lobes_are_drawn_where_the_engine_puts_them() {
             when: Some(LocalDateTime { date: Date::new(date.0, date.1, date.2).unwrap(), time: TimeOfDay::from_hours(hours).unwrap() }),
             sky: Some(heliodon::sky::SkySpec::Clear { turbidity: 2.45 }),
             settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
+            light: Default::default(),
             panels: all_panels(),
         };
         let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("sun_{room}_{}_{hours}.png", date.1));
@@ -444,6 +445,7 @@ fn an_overhang_shades_the_lobes_of_a_panel() {
         when: Some(LocalDateTime { date: Date::new(2026, 12, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() }),
         sky: Some(heliodon::sky::SkySpec::Clear { turbidity: 2.45 }),
         settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
+        light: Default::default(),
         panels: all_panels(),
     };
     let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sun_overhang_prismatic.png");

@@ -44,6 +44,8 @@ pub struct OffscreenRequest {
     /// `None`: the app's default sky.
     pub sky: Option<SkySpec>,
     pub settings: RenderSettings,
+    /// The light engine's settings (a converged reference draws with more rays).
+    pub light: crate::light::LightSettings,
     /// The panel types the scene may name.
     pub panels: crate::panel::PanelCatalog,
 }
@@ -130,6 +132,7 @@ pub fn offscreen_app(request: &OffscreenRequest) -> App {
     app.register_panels(&request.panels);
     app.add_plugins(HeliodonRenderPlugin)
         .insert_resource(request.settings)
+        .insert_resource(crate::ecs::LightSettings(request.light))
         .insert_resource(Job {
             request: request.clone(),
             targets: None,
