@@ -466,23 +466,34 @@ fn compare_direct_sun(path: &std::path::Path, view: &Viewpoint, date: &str, time
 }
 
 /// Every bundled scene from its first camera at two sun positions and from
-/// outside at a third.
+/// outside at a third; and from high above in a low afternoon sun, where
+/// the building's shadow falls long on the ground around it.
 #[test]
 fn direct_sun_images_agree_with_a_ray_traced_reference() {
     for name in heliodon::BUNDLED_SCENES {
         let path = heliodon::bundled_scene(name);
         let scene = load_scene(&path, &PanelCatalog::new()).unwrap().scene;
         let overview = overview(&scene);
+        let above = Viewpoint {
+            name: "above".into(),
+            eye: overview.target + Vec3::new(0.0, -0.3, 1.0) * 2.0 * (overview.eye - overview.target).length(),
+            ..overview.clone()
+        };
         let cases = [
             (&scene.viewpoints[0], "2026-03-21", "10:00"),
             (&scene.viewpoints[0], "2026-11-10", "14:30"),
             (&overview, "2026-12-21", "12:00"),
+            (&above, "2026-03-21", "16:30"),
         ];
         for (view, date, time) in cases {
             let (result, summary) = compare_direct_sun(&path, view, date, time);
             assert!(result.compared > 320 * 200 / 10, "{summary}");
             assert!(result.lit > 200, "too few sunlit pixels to compare: {summary}");
             assert!(result.agreement >= 0.99 && result.within >= 0.99, "{summary}");
+            if view.name == "above" {
+                // The view is all model and ground; the shadow is a good part of it.
+                assert!(result.compared > 320 * 200 * 99 / 100 && result.compared - result.lit > 320 * 200 / 50, "{summary}");
+            }
         }
     }
 }

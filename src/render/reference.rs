@@ -1,5 +1,6 @@
 //! A CPU reference for the direct-sun image: each pixel's ray finds its
-//! surface in the light engine's BVH, then shadow rays from there go toward
+//! surface in the light engine's BVH (or the ground drawn under the model,
+//! `GroundPlane`), then shadow rays from there go toward
 //! the sun through glass (Radiance's transmittance) and along each panel
 //! lobe through its panel's windows ([`LightModel::sun_irradiance`]). The
 //! renderer's `sun` mode is checked against it, pixel by pixel.
@@ -36,7 +37,7 @@ pub fn camera_rays(view: &Viewpoint, width: u32, height: u32) -> Vec<DVec3> {
 /// How a rendered direct-sun image agrees with the reference.
 #[derive(Debug, Clone)]
 pub struct SunComparison {
-    /// Pixels whose ray meets a diffuse surface.
+    /// Pixels whose ray meets a diffuse surface or the ground.
     pub compared: usize,
     /// Share of them that agree on lit (above 1 cd/m²) or unlit.
     pub agreement: f64,
@@ -83,13 +84,23 @@ pub fn compare_direct_sun(request: &OffscreenRequest, picture: &Path) -> Result<
     let mut disagreement = image::RgbImage::new(width, height);
     let eye = view.eye.as_dvec3();
     let beams = model.sun_beams(&sun);
+    let ground = heliodon_core::sun_pass::GroundPlane::of(&scene);
     for (k, (ray, pixel)) in camera_rays(&view, width, height).into_iter().zip(&image.physical).enumerate() {
-        let Some((patch, distance)) = model.trace(eye, ray) else { continue };
-        let patch = &scene.patches.patches[patch as usize];
-        let MaterialKind::Diffuse { reflectance } = &scene.materials[patch.material as usize].kind else { continue };
-        let normal = patch.normal.as_dvec3() * if patch.normal.as_dvec3().dot(ray) > 0.0 { -1.0 } else { 1.0 };
-        let irradiance = model.beams_irradiance(eye + ray * distance, normal, &beams);
-        let expected = f64::from(reflectance.0[1]) / std::f64::consts::PI * irradiance * LUMINOUS_EFFICACY;
+        // The model, or where the ray passes it, the ground drawn under it.
+        let (point, normal, reflectance) = match model.trace(eye, ray) {
+            Some((patch, distance)) => {
+                let patch = &scene.patches.patches[patch as usize];
+                let MaterialKind::Diffuse { reflectance } = &scene.materials[patch.material as usize].kind else { continue };
+                let normal = patch.normal.as_dvec3() * if patch.normal.as_dvec3().dot(ray) > 0.0 { -1.0 } else { 1.0 };
+                (eye + ray * distance, normal, reflectance.0[1])
+            }
+            None => match ground.hit(eye, ray) {
+                Some(point) => (point, DVec3::Z, ground.reflectance),
+                None => continue,
+            },
+        };
+        let irradiance = model.beams_irradiance(point, normal, &beams);
+        let expected = f64::from(reflectance) / std::f64::consts::PI * irradiance * LUMINOUS_EFFICACY;
         let got = f64::from(pixel[1]);
         compared += 1;
         let (reference_lit, picture_lit) = (expected > 1.0, got > 1.0);

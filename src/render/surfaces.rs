@@ -7,6 +7,9 @@
 //! meshes lies the model's own (watertight) triangles, pushed back in depth
 //! and shaded with each surface's mean: where patch clipping leaves
 //! T-junctions between surfaces, a crack shows that instead of the sky.
+//! Around the model lies the ground outside ([`GroundPlane`]), lit by the
+//! sky here and by the sun in the sun pass, which draws the building's
+//! shadow on it.
 
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -18,10 +21,11 @@ use bevy::render::render_resource::{AsBindGroup, ShaderType};
 use bevy::shader::ShaderRef;
 
 use super::{HeliodonRenderSystems, RenderMode, RenderSettings};
-use crate::ecs::{ActiveScene, LightingState, SceneSpawned};
+use crate::ecs::{ActiveScene, LightingState, SceneSpawned, SunSky};
 use crate::light::{Channels, side_of};
 use crate::scene::{MaterialKind, Scene};
 use crate::sky::LUMINOUS_EFFICACY;
+use heliodon_core::sun_pass::GroundPlane;
 
 pub struct SurfaceLightingPlugin;
 
@@ -30,8 +34,10 @@ impl Plugin for SurfaceLightingPlugin {
         let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
         let _ =
             shaders.insert(LIGHTING_SHADER.id(), Shader::from_wgsl(include_str!("../../shaders/lighting.wgsl"), "shaders/lighting.wgsl"));
-        app.add_plugins(MaterialPlugin::<LightingMaterial>::default())
-            .add_systems(Update, (spawn_surface_meshes, update_surface_values).chain().in_set(HeliodonRenderSystems::Surfaces));
+        app.add_plugins(MaterialPlugin::<LightingMaterial>::default()).add_systems(
+            Update,
+            (spawn_surface_meshes, update_surface_values, update_ground).chain().in_set(HeliodonRenderSystems::Surfaces),
+        );
     }
 }
 
@@ -53,6 +59,20 @@ pub struct LightingMaterial {
     pub vertical_section: Vec4,
     /// Drawn behind the patch meshes, filling their cracks.
     pub underlay: bool,
+}
+
+impl LightingMaterial {
+    /// A surface's material under the view's `settings`.
+    fn new(settings: &RenderSettings, tint: LinearRgba, underlay: bool) -> Self {
+        Self {
+            tint,
+            mode: settings.mode,
+            scale_max_lux: settings.false_colour_max_lux,
+            section: section_height(settings),
+            vertical_section: vertical_plane(settings),
+            underlay,
+        }
+    }
 }
 
 /// What changes the pipeline: the underlay's depth bias.
@@ -142,6 +162,13 @@ fn spawn_surface_meshes(
 ) {
     let Some(SceneSpawned { root, .. }) = spawned.read().last() else { return };
     let Some(scene) = &active.scene else { return };
+    let ground = GroundPlane::of(scene);
+    commands.spawn((
+        Mesh3d(meshes.add(ground_mesh(&ground))),
+        MeshMaterial3d(materials.add(LightingMaterial::new(&settings, LinearRgba::BLACK, false))),
+        Ground(ground),
+        ChildOf(*root),
+    ));
     for (index, material) in scene.materials.iter().enumerate() {
         let Some((mesh, values)) = material_mesh(scene, index as u32) else { continue };
         let tint = match &material.kind {
@@ -150,14 +177,7 @@ fn spawn_surface_meshes(
             MaterialKind::Glass { transmittance } => LinearRgba { alpha: (1.0 - transmittance).clamp(0.02, 1.0), ..GLASS_TINT },
             MaterialKind::Panel { .. } => PANEL_TINT,
         };
-        let lighting = |underlay| LightingMaterial {
-            tint,
-            mode: settings.mode,
-            scale_max_lux: settings.false_colour_max_lux,
-            section: section_height(&settings),
-            vertical_section: vertical_plane(&settings),
-            underlay,
-        };
+        let lighting = |underlay| LightingMaterial::new(&settings, tint, underlay);
         let mut entity = commands.spawn((Mesh3d(meshes.add(mesh)), MeshMaterial3d(materials.add(lighting(false))), ChildOf(*root)));
         if let MaterialKind::Diffuse { reflectance } = &material.kind {
             entity.insert(SurfaceValues { reflectance: reflectance.0, ..values });
@@ -168,6 +188,45 @@ fn spawn_surface_meshes(
                 SurfaceValues { reflectance: reflectance.0, ..values },
                 ChildOf(*root),
             ));
+        }
+    }
+}
+
+/// The ground outside, as drawn ([`GroundPlane`]).
+#[derive(Component)]
+pub struct Ground(GroundPlane);
+
+/// The ground's square, facing up, with the same corners the sun pass
+/// lights (so their depths match).
+fn ground_mesh(ground: &GroundPlane) -> Mesh {
+    let [a, b, c, d] = ground.corners();
+    let mut builder = MeshBuilder::default();
+    builder.triangle([a, b, c], Vec3::Z, [0; 3]);
+    builder.triangle([a, c, d], Vec3::Z, [0; 3]);
+    builder.build().0
+}
+
+/// The ground's sky light (cd/m²: ρ/π of the sky's horizontal irradiance,
+/// as a surface open to the whole sky gets it) in the modes that draw the
+/// sky; in sun mode the sun pass alone lights it. The indirect and
+/// false-colour views are about the model's surfaces: no ground.
+fn update_ground(
+    sun_sky: Option<Res<SunSky>>,
+    settings: Res<RenderSettings>,
+    mut grounds: Query<(&Ground, &Mesh3d, &mut Visibility)>,
+    added: Query<(), Added<Ground>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+) {
+    if !sun_sky.as_ref().is_some_and(|s| s.is_changed()) && !settings.is_changed() && added.is_empty() {
+        return;
+    }
+    for (ground, mesh, mut visibility) in &mut grounds {
+        let shown = matches!(settings.mode, RenderMode::Full | RenderMode::Sky | RenderMode::Sun);
+        *visibility = if shown { Visibility::Inherited } else { Visibility::Hidden };
+        let sky = sun_sky.as_ref().filter(|_| settings.mode != RenderMode::Sun).map_or(0.0, |s| s.sky.diffuse_horizontal);
+        let luminance = (f64::from(ground.0.reflectance) / PI * sky * LUMINOUS_EFFICACY) as f32;
+        if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
+            mesh.insert_attribute(Mesh::ATTRIBUTE_COLOR, vec![[luminance, luminance, luminance, 1.0]; 6]);
         }
     }
 }

@@ -9,7 +9,8 @@
 //!   sun, then every panel lobe as a fake sun), its opaque casters' volume
 //!   and its lights through apertures (glass windows of one material facing
 //!   one way, or a panel group's windows);
-//! - [`lit_vertices`]: the diffuse surfaces the lit passes draw.
+//! - [`lit_vertices`]: the diffuse surfaces the lit passes draw, and the
+//!   ground outside ([`GroundPlane`]), where the building's shadow falls.
 
 mod shadow_volume;
 
@@ -239,10 +240,61 @@ fn beside(casters: &[[Vec3; 3]], origin: Vec3, side: Vec3) -> Vec<[Vec3; 3]> {
     out
 }
 
+/// The ground outside as the renderer draws it: a horizontal square of the
+/// site's ground reflectance just under the model's lowest point, far wider
+/// than the model, so the building's sun shadow falls on it. The light
+/// engine does not see it (its ground is the sky model's glow below the
+/// horizon, of the same luminance where the sun reaches); a model with a
+/// ground of its own covers it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GroundPlane {
+    /// Its height (model z).
+    pub height: f32,
+    /// Its middle, under the middle of the model.
+    pub centre: glam::Vec2,
+    /// Half its side.
+    pub half_size: f32,
+    /// The site's ground reflectance.
+    pub reflectance: f32,
+}
+
+/// How far under the model's lowest point the drawn ground lies (m): a
+/// model's own ground polygon there hides it without z-fighting.
+const GROUND_BELOW: f32 = 0.01;
+
+impl GroundPlane {
+    /// The ground drawn around `scene`: reaching 20 model widths and at least
+    /// a kilometre out.
+    pub fn of(scene: &Scene) -> Self {
+        let (lo, hi) = scene.bounds;
+        let width = (hi - lo).truncate().length();
+        Self {
+            height: lo.z - GROUND_BELOW,
+            centre: ((lo + hi) * 0.5).truncate(),
+            half_size: (20.0 * width).max(1000.0),
+            reflectance: scene.site.ground_reflectance as f32,
+        }
+    }
+
+    /// Its corners, anticlockwise seen from above (facing up).
+    pub fn corners(&self) -> [Vec3; 4] {
+        let (c, r) = (self.centre, self.half_size);
+        [[-r, -r], [r, -r], [r, r], [-r, r]].map(|[x, y]| Vec3::new(c.x + x, c.y + y, self.height))
+    }
+
+    /// Where a ray from `origin` along `direction` meets it from above.
+    pub fn hit(&self, origin: glam::DVec3, direction: glam::DVec3) -> Option<glam::DVec3> {
+        let t = (f64::from(self.height) - origin.z) / direction.z;
+        let point = origin + direction * t;
+        let inside = (point.truncate() - self.centre.as_dvec2()).abs().max_element() <= f64::from(self.half_size);
+        (origin.z > f64::from(self.height) && t > 0.0 && inside).then_some(point)
+    }
+}
+
 /// The diffuse surfaces as the sun pass draws them: the very triangles of
-/// the patch meshes the main pass drew, so their depths match exactly.
-/// A face the model holds twice is drawn once (light is added, so a
-/// duplicate would double it).
+/// the patch meshes the main pass drew, so their depths match exactly,
+/// then the ground outside ([`GroundPlane`]). A face the model holds twice
+/// is drawn once (light is added, so a duplicate would double it).
 pub fn lit_vertices(scene: &Scene) -> Vec<f32> {
     let mut out = Vec::new();
     let mut seen = std::collections::HashSet::new();
@@ -260,6 +312,13 @@ pub fn lit_vertices(scene: &Scene) -> Vec<f32> {
                 out.extend(reflectance.0);
             }
         }
+    }
+    let ground = GroundPlane::of(scene);
+    let [a, b, c, d] = ground.corners();
+    for v in [a, b, c, a, c, d] {
+        out.extend(v.to_array());
+        out.extend([0.0, 0.0, 1.0]);
+        out.extend([ground.reflectance; 3]);
     }
     out
 }
