@@ -17,15 +17,33 @@ struct LightingMaterial {
     scale_max_lux: f32,
     // Fragments above this height (model z) are cut away from the eye.
     section: f32,
+    // 1: a panel, drawn with its look (below).
+    is_panel: u32,
     // A vertical section: fragments with dot(normal, p) > offset are cut
     // away (xy: the horizontal normal, w: the offset; a zero normal: none).
     vertical_section: vec4<f32>,
+    panel: PanelLook,
+}
+
+// A panel's look under the sun: the diffusely transmitted sun's luminance
+// (cd/m²), and per lobe the way its light travels into the room (xyz) with
+// the cosine of its cone's half angle (w) and its luminance (x of
+// lobe_luminance): the eye sees a lobe where it looks at the panel from
+// within the cone, against the light.
+struct PanelLook {
+    diffuse: f32,
+    lobe_count: u32,
+    lobes: array<vec4<f32>, 8>,
+    lobe_luminance: array<vec4<f32>, 8>,
 }
 
 // Surfaces within this distance of a section are drawn in the cut colour:
 // a line where the section cuts them, so the cut reads as one.
 const CUT_LINE: f32 = 0.03;
 const CUT_COLOUR: vec4<f32> = vec4(0.55, 0.08, 0.06, 1.0);
+// The most a panel's light is drawn at, after exposure: the view's
+// half-float target holds 65,504.
+const MAX_DRAWN: f32 = 60000.0;
 
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var<uniform> material: LightingMaterial;
 
@@ -58,6 +76,23 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
 #else
     let value = vec3(0.0);
 #endif
+    if material.tint.a < 1.0 && material.is_panel == 1u {
+        // Premultiplied: the panel's body by its coverage, plus the light it
+        // sends toward the eye (luminance modes only).
+        var light = 0.0;
+        if material.mode == 0u {
+            let to_eye = normalize(view.world_position - in.world_position.xyz);
+            light = material.panel.diffuse;
+            for (var k = 0u; k < material.panel.lobe_count; k++) {
+                let lobe = material.panel.lobes[k];
+                // A soft rim a thousandth of the cosine wide, against aliasing.
+                light += material.panel.lobe_luminance[k].x * smoothstep(lobe.w - 1e-3, lobe.w, dot(to_eye, lobe.xyz));
+            }
+        }
+        // Kept within the half-float target (a lobe seen against its light
+        // may be millions of cd/m²): the physical image saturates there.
+        return vec4(material.tint.rgb * material.tint.a + min(light * view.exposure, MAX_DRAWN), material.tint.a);
+    }
     if material.tint.a < 1.0 {
         return material.tint;
     }

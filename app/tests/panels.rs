@@ -420,6 +420,61 @@ fn panel_lobes_are_drawn_where_the_engine_puts_them() {
     }
 }
 
+/// A panel is seen as what it sends into the room: an eye inside a lobe's
+/// cone, looking back at the panel against the lobe's light, sees it as
+/// bright as the lobe (E·share/cos θout over the cone's solid angle,
+/// saturating the physical image at 60,000 cd/m²); an eye outside every
+/// cone sees its diffuse light and what shows through it, far dimmer.
+#[test]
+fn a_panel_shows_its_lobes_to_an_eye_inside_their_cones() {
+    use heliodon::glam::DVec3;
+    use heliodon::light::LightModel;
+    use heliodon::render::offscreen::{OffscreenRequest, render};
+    use heliodon::render::{RenderMode, RenderSettings};
+    use heliodon::scene::Viewpoint;
+    use heliodon::time::{Date, LocalDateTime, TimeOfDay};
+    let path = room("lobe_look", Some("panel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n"));
+    let scene = std::sync::Arc::new(load_scene(&path, &all_panels()).unwrap().scene);
+    let sun = winter_noon(&scene).sun_up().unwrap();
+    let looks = LightModel::unlit(scene.clone()).panel_looks(&sun);
+    assert_eq!(looks.len(), 1, "one panel group");
+    let cone = |l: &heliodon::light::LobeLook| l.luminance * (1.0 - l.half_angle.cos());
+    let lobe = *looks[0].lobes.iter().max_by(|a, b| cone(a).total_cmp(&cone(b))).expect("the winter sun makes lobes");
+    // The panel's middle; eyes 2 m from it, inside the room.
+    let middle = DVec3::new(2.0, 0.0, 1.5);
+    let seen_from = |direction: DVec3| {
+        let eye = middle + direction * 2.0;
+        assert!(eye.y > 0.1 && eye.y < 5.9 && eye.z > 0.1 && eye.z < 2.9, "{eye} is in the room");
+        let view = Viewpoint { name: "panel".into(), eye: eye.as_vec3(), target: middle.as_vec3(), fov: 10.0 };
+        let image = render(OffscreenRequest {
+            scene: path.clone(),
+            view: Some(view),
+            width: 33,
+            height: 33,
+            when: Some(LocalDateTime { date: Date::new(2026, 12, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() }),
+            sky: Some(heliodon::sky::SkySpec::Clear { turbidity: 2.45 }),
+            settings: RenderSettings { mode: RenderMode::Full, exposure: Some(12.0), ..Default::default() },
+            light: quick(),
+            panels: all_panels(),
+        })
+        .unwrap();
+        heliodon::light::luminous(image.physical[16 * 33 + 16].map(f64::from))
+    };
+    // Off the lobe by three of its half angles, turned about the panel's
+    // horizontal axis, and inside no other lobe's cone.
+    let off = {
+        let (s, c) = (3.0 * lobe.half_angle).sin_cos();
+        let d = DVec3::new(lobe.travel.x, lobe.travel.y * c - lobe.travel.z * s, lobe.travel.y * s + lobe.travel.z * c);
+        assert!(looks[0].lobes.iter().all(|l| d.dot(l.travel) < l.half_angle.cos()), "{d} is outside every cone");
+        d
+    };
+    let (inside, outside) = (seen_from(lobe.travel), seen_from(off));
+    let expected = lobe.luminance.min(60_000.0);
+    println!("lobe {lobe:?}, diffuse {:.0} cd/m²: seen inside its cone {inside:.0} cd/m², outside {outside:.0}", looks[0].diffuse);
+    assert!(inside > 0.95 * expected, "{inside} against {expected}");
+    assert!(outside < 0.25 * inside, "{outside} against {inside}");
+}
+
 /// Exterior shading acts on the real sun before the panel turns it into
 /// lobes: the overhang's shadow on a prismatic window keeps each lobe's
 /// light off part of the floor, in the engine and in the picture alike.

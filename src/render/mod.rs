@@ -59,7 +59,7 @@ impl Plugin for HeliodonRenderPlugin {
                     .after(HeliodonSystems::Lighting),
             )
             .add_plugins((SurfaceLightingPlugin, SunPassPlugin, sky::SkyBackgroundPlugin))
-            .add_systems(Update, update_sun_pass.in_set(HeliodonRenderSystems::SunPass))
+            .add_systems(Update, (update_sun_pass, surfaces::update_panel_looks).in_set(HeliodonRenderSystems::SunPass))
             .add_systems(Update, (auto_exposure, tone_mapping_for_mode).in_set(HeliodonRenderSystems::Exposure));
     }
 }
@@ -89,7 +89,7 @@ impl RenderMode {
         Some([Self::Full, Self::Sun, Self::Sky, Self::Indirect, Self::FalseColour][index])
     }
 
-    fn draws_sun(self) -> bool {
+    pub(crate) fn draws_sun(self) -> bool {
         matches!(self, Self::Full | Self::Sun)
     }
 }

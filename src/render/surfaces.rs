@@ -22,7 +22,7 @@ use bevy::shader::ShaderRef;
 
 use super::{HeliodonRenderSystems, RenderMode, RenderSettings};
 use crate::ecs::{ActiveScene, LightingState, SceneSpawned, SunSky};
-use crate::light::{Channels, side_of};
+use crate::light::{Channels, LobeLook, PanelLook, side_of};
 use crate::scene::{MaterialKind, Scene};
 use crate::sky::LUMINOUS_EFFICACY;
 use heliodon_core::sun_pass::GroundPlane;
@@ -59,6 +59,35 @@ pub struct LightingMaterial {
     pub vertical_section: Vec4,
     /// Drawn behind the patch meshes, filling their cracks.
     pub underlay: bool,
+    /// A panel's look under the sun (none for other surfaces).
+    pub panel: Option<PanelLookUniform>,
+}
+
+/// The most lobes a panel is drawn with (the brightest when it has more).
+const MAX_DRAWN_LOBES: usize = 8;
+
+/// A panel's look for the shader ([`heliodon_core::light::PanelLook`]):
+/// the diffuse sun's luminance and per lobe the way its light travels
+/// (xyz) with the cosine of its cone's half angle (w), and its luminance.
+#[derive(ShaderType, Debug, Clone, Copy, Default, PartialEq)]
+pub struct PanelLookUniform {
+    diffuse: f32,
+    lobe_count: u32,
+    lobes: [Vec4; MAX_DRAWN_LOBES],
+    lobe_luminance: [Vec4; MAX_DRAWN_LOBES],
+}
+
+impl PanelLookUniform {
+    fn new(look: &PanelLook) -> Self {
+        let mut lobes: Vec<&LobeLook> = look.lobes.iter().collect();
+        lobes.sort_by(|a, b| (b.luminance * b.half_angle * b.half_angle).total_cmp(&(a.luminance * a.half_angle * a.half_angle)));
+        let mut uniform = Self { diffuse: look.diffuse as f32, lobe_count: lobes.len().min(MAX_DRAWN_LOBES) as u32, ..Default::default() };
+        for (k, lobe) in lobes.into_iter().take(MAX_DRAWN_LOBES).enumerate() {
+            uniform.lobes[k] = lobe.travel.as_vec3().extend(lobe.half_angle.cos() as f32);
+            uniform.lobe_luminance[k] = Vec4::new(lobe.luminance as f32, 0.0, 0.0, 0.0);
+        }
+        uniform
+    }
 }
 
 impl LightingMaterial {
@@ -71,6 +100,7 @@ impl LightingMaterial {
             section: section_height(settings),
             vertical_section: vertical_plane(settings),
             underlay,
+            panel: None,
         }
     }
 }
@@ -93,7 +123,10 @@ pub struct LightingMaterialUniform {
     mode: u32,
     scale_max_lux: f32,
     section: f32,
+    /// 1: a panel, drawn with its look.
+    is_panel: u32,
     vertical_section: Vec4,
+    panel: PanelLookUniform,
 }
 
 impl bevy::render::render_resource::AsBindGroupShaderType<LightingMaterialUniform> for LightingMaterial {
@@ -106,7 +139,9 @@ impl bevy::render::render_resource::AsBindGroupShaderType<LightingMaterialUnifor
             mode: u32::from(self.mode == RenderMode::FalseColour),
             scale_max_lux: self.scale_max_lux,
             section: self.section,
+            is_panel: u32::from(self.panel.is_some()),
             vertical_section: self.vertical_section,
+            panel: self.panel.unwrap_or_default(),
         }
     }
 }
@@ -117,7 +152,12 @@ impl Material for LightingMaterial {
     }
 
     fn alpha_mode(&self) -> AlphaMode {
-        if self.tint.alpha < 1.0 { AlphaMode::Blend } else { AlphaMode::Opaque }
+        match self.tint.alpha < 1.0 {
+            // A panel adds the light it sends toward the eye to what shows through.
+            true if self.panel.is_some() => AlphaMode::Premultiplied,
+            true => AlphaMode::Blend,
+            false => AlphaMode::Opaque,
+        }
     }
 
     fn specialize(
@@ -138,7 +178,8 @@ impl Material for LightingMaterial {
 }
 
 /// Glass as a faint blue-grey (its alpha is its opacity, 1 − τ), panels
-/// amber: readable at any exposure.
+/// amber: readable at any exposure (a panel adds the light it sends toward
+/// the eye, [`update_panel_looks`]).
 const GLASS_TINT: LinearRgba = LinearRgba::new(0.35, 0.45, 0.55, 0.18);
 const PANEL_TINT: LinearRgba = LinearRgba::new(0.7, 0.5, 0.2, 0.3);
 
@@ -178,7 +219,12 @@ fn spawn_surface_meshes(
             MaterialKind::Panel { .. } => PANEL_TINT,
         };
         let lighting = |underlay| LightingMaterial::new(&settings, tint, underlay);
-        let mut entity = commands.spawn((Mesh3d(meshes.add(mesh)), MeshMaterial3d(materials.add(lighting(false))), ChildOf(*root)));
+        let is_panel = matches!(material.kind, MaterialKind::Panel { .. });
+        let surface = LightingMaterial { panel: is_panel.then(PanelLookUniform::default), ..lighting(false) };
+        let mut entity = commands.spawn((Mesh3d(meshes.add(mesh)), MeshMaterial3d(materials.add(surface)), ChildOf(*root)));
+        if is_panel {
+            entity.insert(PanelSurface(index as u32));
+        }
         if let MaterialKind::Diffuse { reflectance } = &material.kind {
             entity.insert(SurfaceValues { reflectance: reflectance.0, ..values });
             let (mesh, values) = underlay_mesh(scene, index as u32);
@@ -188,6 +234,38 @@ fn spawn_surface_meshes(
                 SurfaceValues { reflectance: reflectance.0, ..values },
                 ChildOf(*root),
             ));
+        }
+    }
+}
+
+/// The mesh of a panel material (index into the scene's materials).
+#[derive(Component)]
+pub struct PanelSurface(u32);
+
+/// Panels as they look under the current sun ([`crate::light::LightModel::panel_looks`]):
+/// their lobes bright where the eye looks against them, the diffusely
+/// transmitted sun everywhere, in the modes that draw direct sun.
+pub(super) fn update_panel_looks(
+    ray_model: Option<Res<super::RayModel>>,
+    sun_sky: Option<Res<SunSky>>,
+    settings: Res<RenderSettings>,
+    panels: Query<(&PanelSurface, &MeshMaterial3d<LightingMaterial>)>,
+    added: Query<(), Added<PanelSurface>>,
+    mut materials: ResMut<Assets<LightingMaterial>>,
+) {
+    let changed = ray_model.as_ref().is_some_and(|r| r.is_changed()) || sun_sky.as_ref().is_some_and(|s| s.is_changed());
+    if panels.is_empty() || (!changed && !settings.is_changed() && added.is_empty()) {
+        return;
+    }
+    let sun = sun_sky.as_ref().and_then(|s| s.sky.sun_up()).filter(|_| settings.mode.draws_sun());
+    let looks = match (&ray_model, &sun) {
+        (Some(model), Some(sun)) => model.0.panel_looks(sun),
+        _ => Vec::new(),
+    };
+    for (panel, material) in &panels {
+        let look = looks.iter().find(|l| l.material == panel.0).map(PanelLookUniform::new).unwrap_or_default();
+        if let Some(mut material) = materials.get_mut(&material.0) {
+            material.panel = Some(look);
         }
     }
 }

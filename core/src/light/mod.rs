@@ -52,7 +52,7 @@ pub use coefficients::{SensorCoefficients, SunPath};
 pub use gather::{Gather, SkyKey, sensor_points, side_of};
 pub use glass::Glass;
 pub use measured::MeasuredSun;
-pub use panels::{PanelFrame, SunBeam};
+pub use panels::{LobeLook, PanelFrame, PanelLook, SunBeam};
 pub use settings::LightSettings;
 pub use solver::{Interreflection, Relight, form_factor_product};
 pub use windows::{WindowGroup, WindowGroups};

@@ -15,7 +15,7 @@ use super::windows::WindowGroups;
 use super::{LightModel, SURFACE_OFFSET};
 use crate::panel::{Lobe, PanelModel};
 use crate::scene::{MaterialKind, Scene};
-use crate::sky::{SkyPatches, SunSource};
+use crate::sky::{LUMINOUS_EFFICACY, SkyPatches, SunSource};
 
 /// A panel's frame in the model: z into the room, y its up, x = y × z.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -291,6 +291,78 @@ pub struct SunBeam {
     pub normal_irradiance: f64,
     /// The panel group the beam comes out of; `None` for the sun itself.
     pub panel_group: Option<u32>,
+}
+
+/// How a panel's room side looks under the sun: the light it sends into the
+/// room, as an eye there sees it on the panel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PanelLook {
+    /// The panel material (index into [`Scene::materials`]).
+    pub material: u32,
+    /// The diffusely transmitted sun: its luminance the same from every
+    /// direction, cd/m².
+    pub diffuse: f64,
+    /// The transmitted lobes, each light filling a cone evenly.
+    pub lobes: Vec<LobeLook>,
+}
+
+/// A lobe seen from the room: looking at the panel from within its cone,
+/// against the way its light travels, the eye sees it at `luminance`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LobeLook {
+    /// The way its light travels into the room (unit).
+    pub travel: DVec3,
+    /// The cone's half angle, radians (at least [`LOBE_LOOK_HALF_ANGLE`]).
+    pub half_angle: f64,
+    /// cd/m².
+    pub luminance: f64,
+}
+
+/// The narrowest cone a lobe is drawn in, radians: a lobe narrower than that
+/// (a mirror's, 0°) would be a point; it shows as a small bright disc the
+/// size of a sun of 2°.
+pub const LOBE_LOOK_HALF_ANGLE: f64 = 0.0175;
+
+impl LightModel {
+    /// Each panel group's look under `sun`: the model's response to it
+    /// ([`PanelModel::response`]), the irradiance the panel's area receives
+    /// (E·cos θin, times the share of its window points the sun reaches)
+    /// turned into luminance: lobes over their cone's solid angle, the
+    /// diffuse part over π.
+    pub fn panel_looks(&self, sun: &SunSource) -> Vec<PanelLook> {
+        self.panel_groups
+            .iter()
+            .enumerate()
+            .map(|(g, group)| {
+                let incoming = group.frame.to_panel(-sun.direction);
+                let points = &self.panel_samples[g].points;
+                let sunlit =
+                    points.iter().filter(|&&p| self.sun_transmittance(p + sun.direction * SURFACE_OFFSET, sun.direction) > 0.0).count();
+                let irradiance = sun.normal_irradiance() * incoming.z.max(0.0) * sunlit as f64 / points.len().max(1) as f64;
+                let mut look = PanelLook { material: group.material, diffuse: 0.0, lobes: Vec::new() };
+                if irradiance <= 0.0 {
+                    return look;
+                }
+                let response = group.model.response(incoming);
+                look.diffuse = irradiance * response.diffuse_transmittance / std::f64::consts::PI * LUMINOUS_EFFICACY;
+                for lobe in response.lobes.iter().filter(|l| l.direction.z > 1e-6 && l.share > 0.0) {
+                    let direction = lobe.direction.normalize();
+                    // (A NaN width reads as narrow, as in `spread`.)
+                    let width = if lobe.width.is_nan() { 0.0 } else { lobe.width };
+                    let half_angle = (0.5 * width).to_radians().clamp(LOBE_LOOK_HALF_ANGLE, std::f64::consts::FRAC_PI_2);
+                    let solid_angle = std::f64::consts::TAU * (1.0 - half_angle.cos());
+                    // The flux on the panel's area, spread over the lobe's cross section.
+                    let normal_irradiance = irradiance * lobe.share / direction.z;
+                    look.lobes.push(LobeLook {
+                        travel: group.frame.to_world(direction).normalize(),
+                        half_angle,
+                        luminance: normal_irradiance / solid_angle * LUMINOUS_EFFICACY,
+                    });
+                }
+                look
+            })
+            .collect()
+    }
 }
 
 /// The panel groups of a scene (one per window group of a panel material,
