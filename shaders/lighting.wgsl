@@ -25,13 +25,18 @@ struct LightingMaterial {
     panel: PanelLook,
 }
 
-// A panel's look under the sun: the diffusely transmitted sun's luminance
-// (cd/m²), and per lobe the way its light travels into the room (xyz) with
+// A panel's look under the sky: the sky and ground it passes into the room
+// by the way the eye looks out through it (panel_sky, cd/m²), the
+// diffusely transmitted sun's luminance (cd/m²), and per lobe the way its light travels into the room (xyz) with
 // the cosine of its cone's half angle (w) and its luminance (x of
 // lobe_luminance): the eye sees a lobe where it looks at the panel from
 // within the cone, against the light.
 struct PanelLook {
+    // The panel's normal into the room: the side it looks like this from.
+    inward: vec4<f32>,
     diffuse: f32,
+    // 1: the sky it passes is drawn (panel_sky), 0: not in this mode.
+    sky: f32,
     lobe_count: u32,
     lobes: array<vec4<f32>, 8>,
     lobe_luminance: array<vec4<f32>, 8>,
@@ -46,6 +51,8 @@ const CUT_COLOUR: vec4<f32> = vec4(0.55, 0.08, 0.06, 1.0);
 const MAX_DRAWN: f32 = 60000.0;
 
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var<uniform> material: LightingMaterial;
+@group(#{MATERIAL_BIND_GROUP}) @binding(1) var panel_sky: texture_cube<f32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(2) var panel_sky_sampler: sampler;
 
 // The false-colour scale: logarithmic over three decades below the top,
 // blue, cyan, green, yellow, red, white (heliodon::render::false_colour is
@@ -76,22 +83,23 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
 #else
     let value = vec3(0.0);
 #endif
-    if material.tint.a < 1.0 && material.is_panel == 1u {
-        // Premultiplied: the panel's body by its coverage, plus the light it
-        // sends toward the eye (luminance modes only).
-        var light = 0.0;
-        if material.mode == 0u {
-            let to_eye = normalize(view.world_position - in.world_position.xyz);
-            light = material.panel.diffuse;
-            for (var k = 0u; k < material.panel.lobe_count; k++) {
-                let lobe = material.panel.lobes[k];
-                // A soft rim a thousandth of the cosine wide, against aliasing.
-                light += material.panel.lobe_luminance[k].x * smoothstep(lobe.w - 1e-3, lobe.w, dot(to_eye, lobe.xyz));
-            }
+    let to_eye = normalize(view.world_position - in.world_position.xyz);
+    if material.tint.a < 1.0 && material.is_panel == 1u && material.mode == 0u && dot(to_eye, material.panel.inward.xyz) > 0.0 {
+        // Seen from the room, a panel is the light it sends toward the eye:
+        // the sky and ground it passes that way, its diffuse sun, its lobes.
+        var light = material.panel.diffuse + material.panel.sky * textureSampleLevel(panel_sky, panel_sky_sampler, -to_eye, 0.0).r;
+        for (var k = 0u; k < material.panel.lobe_count; k++) {
+            let lobe = material.panel.lobes[k];
+            // A soft rim a thousandth of the cosine wide, against aliasing.
+            light += material.panel.lobe_luminance[k].x * smoothstep(lobe.w - 1e-3, lobe.w, dot(to_eye, lobe.xyz));
         }
         // Kept within the half-float target (a lobe seen against its light
         // may be millions of cd/m²): the physical image saturates there.
-        return vec4(material.tint.rgb * material.tint.a + min(light * view.exposure, MAX_DRAWN), material.tint.a);
+        return vec4(vec3(min(light * view.exposure, MAX_DRAWN)), 1.0);
+    }
+    if material.tint.a < 1.0 && material.is_panel == 1u {
+        // From outside, or in false colour: the panel's display colour.
+        return vec4(material.tint.rgb * material.tint.a, material.tint.a);
     }
     if material.tint.a < 1.0 {
         return material.tint;

@@ -61,27 +61,46 @@ pub struct LightingMaterial {
     pub underlay: bool,
     /// A panel's look under the sun (none for other surfaces).
     pub panel: Option<PanelLookUniform>,
+    /// The sky and ground a panel passes into the room, by the way the eye
+    /// looks out through it (cd/m², a cubemap as wgpu samples them).
+    #[texture(1, dimension = "cube")]
+    #[sampler(2)]
+    pub panel_sky: Option<Handle<Image>>,
 }
 
 /// The most lobes a panel is drawn with (the brightest when it has more).
 const MAX_DRAWN_LOBES: usize = 8;
 
 /// A panel's look for the shader ([`heliodon_core::light::PanelLook`]):
-/// the diffuse sun's luminance and per lobe the way its light travels
-/// (xyz) with the cosine of its cone's half angle (w), and its luminance.
+/// the side it is seen like this from, the diffuse sun's luminance,
+/// whether the sky it passes is drawn (its cubemap, [`LightingMaterial::panel_sky`]),
+/// and per lobe the way its light travels (xyz) with the cosine of its
+/// cone's half angle (w), and its luminance.
 #[derive(ShaderType, Debug, Clone, Copy, Default, PartialEq)]
 pub struct PanelLookUniform {
+    inward: Vec4,
     diffuse: f32,
+    /// 1 where the mode draws the sky, else 0.
+    sky: f32,
     lobe_count: u32,
     lobes: [Vec4; MAX_DRAWN_LOBES],
     lobe_luminance: [Vec4; MAX_DRAWN_LOBES],
 }
 
 impl PanelLookUniform {
-    fn new(look: &PanelLook) -> Self {
-        let mut lobes: Vec<&LobeLook> = look.lobes.iter().collect();
+    /// `look` as `mode` draws it: the sun's parts in the full and sun
+    /// modes, the sky's in the full and sky modes.
+    fn new(look: &PanelLook, mode: RenderMode) -> Self {
+        let sun = mode.draws_sun();
+        let mut lobes: Vec<&LobeLook> = look.lobes.iter().filter(|_| sun).collect();
         lobes.sort_by(|a, b| (b.luminance * b.half_angle * b.half_angle).total_cmp(&(a.luminance * a.half_angle * a.half_angle)));
-        let mut uniform = Self { diffuse: look.diffuse as f32, lobe_count: lobes.len().min(MAX_DRAWN_LOBES) as u32, ..Default::default() };
+        let mut uniform = Self {
+            inward: look.inward.as_vec3().extend(0.0),
+            diffuse: if sun { look.diffuse as f32 } else { 0.0 },
+            sky: f32::from(u8::from(matches!(mode, RenderMode::Full | RenderMode::Sky))),
+            lobe_count: lobes.len().min(MAX_DRAWN_LOBES) as u32,
+            ..Default::default()
+        };
         for (k, lobe) in lobes.into_iter().take(MAX_DRAWN_LOBES).enumerate() {
             uniform.lobes[k] = lobe.travel.as_vec3().extend(lobe.half_angle.cos() as f32);
             uniform.lobe_luminance[k] = Vec4::new(lobe.luminance as f32, 0.0, 0.0, 0.0);
@@ -101,6 +120,7 @@ impl LightingMaterial {
             vertical_section: vertical_plane(settings),
             underlay,
             panel: None,
+            panel_sky: None,
         }
     }
 }
@@ -242,9 +262,10 @@ fn spawn_surface_meshes(
 #[derive(Component)]
 pub struct PanelSurface(u32);
 
-/// Panels as they look under the current sun ([`crate::light::LightModel::panel_looks`]):
-/// their lobes bright where the eye looks against them, the diffusely
-/// transmitted sun everywhere, in the modes that draw direct sun.
+/// Panels as they look under the current sky ([`crate::light::LightModel::panel_looks`]):
+/// the sky and ground they pass, by the way the eye looks out through them;
+/// their lobes bright where the eye looks against one; the diffusely
+/// transmitted sun everywhere.
 pub(super) fn update_panel_looks(
     ray_model: Option<Res<super::RayModel>>,
     sun_sky: Option<Res<SunSky>>,
@@ -252,22 +273,53 @@ pub(super) fn update_panel_looks(
     panels: Query<(&PanelSurface, &MeshMaterial3d<LightingMaterial>)>,
     added: Query<(), Added<PanelSurface>>,
     mut materials: ResMut<Assets<LightingMaterial>>,
+    mut images: ResMut<Assets<Image>>,
 ) {
     let changed = ray_model.as_ref().is_some_and(|r| r.is_changed()) || sun_sky.as_ref().is_some_and(|s| s.is_changed());
     if panels.is_empty() || (!changed && !settings.is_changed() && added.is_empty()) {
         return;
     }
-    let sun = sun_sky.as_ref().and_then(|s| s.sky.sun_up()).filter(|_| settings.mode.draws_sun());
-    let looks = match (&ray_model, &sun) {
-        (Some(model), Some(sun)) => model.0.panel_looks(sun),
-        _ => Vec::new(),
-    };
+    let (Some(model), Some(sun_sky)) = (&ray_model, &sun_sky) else { return };
+    let looks = model.0.panel_looks(&sun_sky.sky);
     for (panel, material) in &panels {
-        let look = looks.iter().find(|l| l.material == panel.0).map(PanelLookUniform::new).unwrap_or_default();
+        let Some(look) = looks.iter().find(|l| l.material == panel.0) else { continue };
+        let sky = panel_sky_cubemap(|outward| model.0.panel_sky_luminance(look, outward));
         if let Some(mut material) = materials.get_mut(&material.0) {
-            material.panel = Some(look);
+            material.panel = Some(PanelLookUniform::new(look, settings.mode));
+            match &material.panel_sky {
+                Some(handle) => {
+                    let _ = images.insert(handle.id(), sky);
+                }
+                None => material.panel_sky = Some(images.add(sky)),
+            }
         }
     }
+}
+
+/// Texels along a side of a panel's sky cubemap: the sky transfer is kept
+/// per sky bin (Reinhart MF:n), a few degrees and more each.
+const PANEL_SKY_FACE: usize = 16;
+
+/// A cubemap (half floats, cd/m²) of `luminance` by the way the eye looks.
+fn panel_sky_cubemap(luminance: impl Fn(crate::glam::DVec3) -> f64) -> Image {
+    use bevy::asset::RenderAssetUsages;
+    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat, TextureViewDescriptor, TextureViewDimension};
+    let side = PANEL_SKY_FACE;
+    let mut data = Vec::with_capacity(6 * side * side * 8);
+    for face in 0..6 {
+        for row in 0..side {
+            for column in 0..side {
+                let value = luminance(super::sky::cube_direction(face, column, row, side)) as f32;
+                for channel in [value, value, value, 1.0] {
+                    data.extend_from_slice(&half::f16::from_f32(channel).to_le_bytes());
+                }
+            }
+        }
+    }
+    let size = Extent3d { width: side as u32, height: side as u32, depth_or_array_layers: 6 };
+    let mut image = Image::new(size, TextureDimension::D2, data, TextureFormat::Rgba16Float, RenderAssetUsages::RENDER_WORLD);
+    image.texture_view_descriptor = Some(TextureViewDescriptor { dimension: Some(TextureViewDimension::Cube), ..default() });
+    image
 }
 
 /// The ground outside, as drawn ([`GroundPlane`]).

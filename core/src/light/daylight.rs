@@ -49,6 +49,12 @@ impl KeyRadiance {
         PI * gather.daylight_coefficients.iter().map(|&(k, w)| f64::from(w) * self.sun_of(k)).sum::<f64>()
     }
 
+    /// What panel group `group` passes: per sphere bin the sky and ground
+    /// seen through it, and its diffusely transmitted sunlight's radiance.
+    pub(super) fn through_panel(&self, group: usize) -> (&[f64], f64) {
+        (&self.panels[group], self.panel_sun[group])
+    }
+
     /// Every distinct radiance a key can carry, in [`RadianceSlots`] order.
     pub(super) fn slots(&self) -> Vec<f64> {
         let mut slots = self.bins.clone();

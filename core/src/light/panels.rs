@@ -293,15 +293,21 @@ pub struct SunBeam {
     pub panel_group: Option<u32>,
 }
 
-/// How a panel's room side looks under the sun: the light it sends into the
+/// How a panel's room side looks under a sky: the light it sends into the
 /// room, as an eye there sees it on the panel.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PanelLook {
     /// The panel material (index into [`Scene::materials`]).
     pub material: u32,
+    /// Its windows' normal into the room: the side it is seen like this from.
+    pub inward: DVec3,
     /// The diffusely transmitted sun: its luminance the same from every
     /// direction, cd/m².
     pub diffuse: f64,
+    /// Sky and ground as the panel passes them into the room, per sphere
+    /// bin of the way the eye looks out through it, cd/m²
+    /// ([`LightModel::panel_sky_luminance`]).
+    pub sky: Vec<f64>,
     /// The transmitted lobes, each light filling a cone evenly.
     pub lobes: Vec<LobeLook>,
 }
@@ -324,28 +330,36 @@ pub struct LobeLook {
 pub const LOBE_LOOK_HALF_ANGLE: f64 = 0.0175;
 
 impl LightModel {
-    /// Each panel group's look under `sun`: the model's response to it
-    /// ([`PanelModel::response`]), the irradiance the panel's area receives
-    /// (E·cos θin, times the share of its window points the sun reaches)
-    /// turned into luminance: lobes over their cone's solid angle, the
-    /// diffuse part over π.
-    pub fn panel_looks(&self, sun: &SunSource) -> Vec<PanelLook> {
+    /// Each panel group's look under `sky`, from what the engine makes of
+    /// it: the sky and ground its windows pass (the radiance behind their
+    /// gather keys, [`super::daylight`]), its diffusely transmitted sun, and
+    /// its lobes ([`PanelModel::response`]), each the irradiance the panel's
+    /// area receives (E·cos θin, times the share of its windows the sun
+    /// reaches) spread over its cone's solid angle.
+    pub fn panel_looks(&self, sky: &crate::sky::Sky) -> Vec<PanelLook> {
+        let behind_keys = self.key_radiance(sky);
+        let sun = sky.sun_up();
         self.panel_groups
             .iter()
             .enumerate()
             .map(|(g, group)| {
+                let (sky_through, sun_diffuse) = behind_keys.through_panel(g);
+                let mut look = PanelLook {
+                    material: group.material,
+                    inward: group.frame.z,
+                    diffuse: sun_diffuse * LUMINOUS_EFFICACY,
+                    sky: sky_through.iter().map(|r| r * LUMINOUS_EFFICACY).collect(),
+                    lobes: Vec::new(),
+                };
+                let Some(sun) = &sun else { return look };
                 let incoming = group.frame.to_panel(-sun.direction);
-                let points = &self.panel_samples[g].points;
-                let sunlit =
-                    points.iter().filter(|&&p| self.sun_transmittance(p + sun.direction * SURFACE_OFFSET, sun.direction) > 0.0).count();
-                let irradiance = sun.normal_irradiance() * incoming.z.max(0.0) * sunlit as f64 / points.len().max(1) as f64;
-                let mut look = PanelLook { material: group.material, diffuse: 0.0, lobes: Vec::new() };
-                if irradiance <= 0.0 {
+                if incoming.z <= 0.0 {
                     return look;
                 }
-                let response = group.model.response(incoming);
-                look.diffuse = irradiance * response.diffuse_transmittance / std::f64::consts::PI * LUMINOUS_EFFICACY;
-                for lobe in response.lobes.iter().filter(|l| l.direction.z > 1e-6 && l.share > 0.0) {
+                let irradiance = sun.normal_irradiance() * incoming.z * self.panel_sunlit(g, sun.direction);
+                for lobe in
+                    group.model.response(incoming).lobes.iter().filter(|l| l.direction.z > 1e-6 && l.share > 0.0 && irradiance > 0.0)
+                {
                     let direction = lobe.direction.normalize();
                     // (A NaN width reads as narrow, as in `spread`.)
                     let width = if lobe.width.is_nan() { 0.0 } else { lobe.width };
@@ -362,6 +376,12 @@ impl LightModel {
                 look
             })
             .collect()
+    }
+
+    /// What an eye in the room sees of the sky and ground through a panel
+    /// of `look`, looking out through it along `outward`, cd/m².
+    pub fn panel_sky_luminance(&self, look: &PanelLook, outward: DVec3) -> f64 {
+        look.sky.get(self.sky_bins.sphere_bin(outward)).copied().unwrap_or(0.0)
     }
 }
 
