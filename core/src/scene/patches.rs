@@ -363,6 +363,14 @@ pub fn estimate(triangles: &[Triangle], surfaces: &[Surface], sizing: &PatchSizi
 /// Surfaces smaller than this share of the allowed patch's area are clutter.
 pub(crate) const CLUTTER: f32 = 0.25;
 
+/// Clutter facing one way is clustered only within layers this thick (m)
+/// along its main axis: parallel sheets apart (a roof's layers, one in the
+/// sun, one in its shadow; a desk over a chair) are separate patches, not
+/// one averaging both. (At 5 cm the Duplex's hallway under such a roof
+/// reads 6.0 lx, at 10 cm 9.9, against Radiance's 3.3; but the furnished
+/// floor of `benches/light.rs` gets 30,103 patches instead of 29,442.)
+const CLUSTER_LAYER: f32 = 0.1;
+
 /// The clusters of clutter: per surface, its cluster (index into the
 /// returned list of member lists), for the surfaces that `clusterable`
 /// allows, that are small where they lie and that no window plane cuts.
@@ -375,7 +383,7 @@ fn clusters(
     clusterable: &[bool],
     cuts: &[CutPlane],
 ) -> (Vec<Option<u32>>, Vec<Vec<u32>>) {
-    type Key = (u32, u8, [i64; 3], Vec<(u32, bool)>);
+    type Key = (u32, u8, [i64; 3], i64, Vec<(u32, bool)>);
     let mut keys: BTreeMap<Key, u32> = BTreeMap::new();
     let mut members: Vec<Vec<u32>> = Vec::new();
     let mut cluster_of = vec![None; surfaces.len()];
@@ -398,7 +406,8 @@ fn clusters(
         let axis = n.abs().max_position();
         let direction = (2 * axis + usize::from(n[axis] < 0.0)) as u8;
         let next = members.len() as u32;
-        let cluster = *keys.entry((surface.material, direction, cube, sides)).or_insert(next);
+        let layer = (centroid[axis] / CLUSTER_LAYER).floor() as i64;
+        let cluster = *keys.entry((surface.material, direction, cube, layer, sides)).or_insert(next);
         if cluster == next {
             members.push(Vec::new());
         }
@@ -611,11 +620,12 @@ mod tests {
 
     #[test]
     fn clutter_gathers_into_one_patch_per_cube_and_direction() {
-        // 40 small squares (0.1 m) in one 0.5 m cube: 20 facing up, 20 facing south.
+        // 40 small squares (0.1 m) in one 0.5 m cube and one layer: 20 facing
+        // up (their heights within 6 cm), 20 facing south.
         let mut tris = Vec::new();
         let mut surfaces = Vec::new();
         for k in 0..40 {
-            let offset = Vec3::new(0.02 + 0.01 * (k % 20) as f32, 0.1, 0.1 + 0.01 * (k % 7) as f32);
+            let offset = Vec3::new(0.02 + 0.01 * (k % 20) as f32, 0.12, 0.12 + 0.01 * (k % 7) as f32);
             let square: Vec<Triangle> = quad(0.1, 0.1)
                 .into_iter()
                 .map(|mut t| {
@@ -643,5 +653,29 @@ mod tests {
         assert_eq!((listed[0], listed[20]), (1, 1));
         let directions: Vec<Vec3> = mesh.patches.iter().map(|p| p.normal).collect();
         assert!(directions.iter().any(|n| (*n - Vec3::NEG_Y).length() < 1e-5) && directions.iter().any(|n| (n.z.abs() - 1.0).abs() < 1e-5));
+    }
+
+    /// Clutter sheets facing the same way in one cube but a layer apart (a
+    /// roof's two skins, one sunlit, one in its shadow) stay two patches.
+    #[test]
+    fn stacked_clutter_sheets_are_not_one_patch() {
+        let mut tris = Vec::new();
+        let mut surfaces = Vec::new();
+        for (k, height) in [0.12, 0.15, 0.32].into_iter().enumerate() {
+            let square: Vec<Triangle> = quad(0.1, 0.1)
+                .into_iter()
+                .map(|mut t| {
+                    t.vertices = t.vertices.map(|p| Vec3::new(p.x + 0.05 * k as f32, p.z, height));
+                    t
+                })
+                .collect();
+            let start = tris.len() as u32;
+            tris.extend(square.iter().copied());
+            surfaces.push(Surface { triangles: start..tris.len() as u32, ..surface_of(&square) });
+        }
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[true; 3], &[], &vec![vec![]; 3]);
+        let heights: Vec<f32> = mesh.patches.iter().map(|p| p.centroid.z).collect();
+        assert_eq!(mesh.patches.len(), 2, "{heights:?}");
+        assert!(heights.iter().any(|z| (z - 0.135).abs() < 1e-4) && heights.iter().any(|z| (z - 0.32).abs() < 1e-4), "{heights:?}");
     }
 }
