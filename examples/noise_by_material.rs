@@ -1,0 +1,86 @@
+//! How noisy the light engine's sky and interreflected light look, by
+//! material: the bundled office (or any scene) drawn from one of its
+//! cameras at the default settings and with 16 times the patch rays (a
+//! converged reference), under an overcast and a clear sky on 21 March at
+//! 14:00; per material, the relative RMS luminance difference of the
+//! pixels showing it (each pixel's material found by tracing the camera's
+//! ray through the model). Issue 17 asks for under 2% on walls and ceilings.
+//!
+//!     cargo run --release --example noise_by_material -- [SCENE [CAMERA [MATERIAL,...]]]
+//!
+//! (`tools/indirect_noise.py` compares any two pictures, all pixels.)
+
+use std::sync::Arc;
+
+use heliodon::light::{LightModel, LightSettings, luminous};
+use heliodon::render::offscreen::{OffscreenRequest, render};
+use heliodon::render::{RenderSettings, reference::camera_rays};
+use heliodon::sky::SkySpec;
+use heliodon::time::{Date, LocalDateTime, TimeOfDay};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let path = args.first().map_or_else(|| heliodon::bundled_scene("office"), std::path::PathBuf::from);
+    let scene = match heliodon::scene::load_scene(&path, &Default::default()) {
+        Ok(loaded) => Arc::new(loaded.scene),
+        Err(error) => {
+            eprintln!("error: {error}");
+            std::process::exit(1);
+        }
+    };
+    let Some(view) = (match args.get(1) {
+        Some(name) => scene.viewpoints.iter().find(|v| &v.name == name).cloned(),
+        None => scene.viewpoints.first().cloned(),
+    }) else {
+        eprintln!("error: {}: no such camera (the scene's [[cameras]] name them)", path.display());
+        std::process::exit(1);
+    };
+    let materials: Vec<&str> = args.get(2).map_or(vec!["wall", "ceiling"], |m| m.split(',').collect());
+    let (width, height) = (320, 200);
+    // Each pixel's material, by the camera's ray.
+    let model = LightModel::unlit(scene.clone());
+    let eye = view.eye.as_dvec3();
+    let material_of: Vec<Option<&str>> = camera_rays(&view, width, height)
+        .into_iter()
+        .map(|ray| {
+            model.trace(eye, ray).map(|(patch, _)| scene.materials[scene.patches.patches[patch as usize].material as usize].name.as_str())
+        })
+        .collect();
+    let default = LightSettings::default();
+    let converged =
+        LightSettings { rays_per_patch: 16 * default.rays_per_patch, window_rays_per_patch: 16 * default.window_rays_per_patch, ..default };
+    for sky in [SkySpec::Overcast, SkySpec::Clear { turbidity: 2.45 }] {
+        let draw = |light| {
+            render(OffscreenRequest {
+                scene: path.clone(),
+                view: Some(view.clone()),
+                width,
+                height,
+                when: Some(LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(14.0).unwrap() }),
+                sky: Some(sky.clone()),
+                settings: RenderSettings::default(),
+                light,
+                panels: Default::default(),
+            })
+            .unwrap_or_else(|error| {
+                eprintln!("error: {error}");
+                std::process::exit(1);
+            })
+        };
+        let (picture, reference) = (draw(default), draw(converged));
+        for material in &materials {
+            let pairs: Vec<(f64, f64)> = (material_of.iter().enumerate())
+                .filter(|(_, m)| **m == Some(*material))
+                .map(|(k, _)| (luminous(picture.physical[k].map(f64::from)), luminous(reference.physical[k].map(f64::from))))
+                .filter(|&(_, r)| r > 1e-3)
+                .collect();
+            if pairs.is_empty() {
+                println!("{sky:?} {material}: not in view");
+                continue;
+            }
+            let rms = (pairs.iter().map(|(p, r)| ((p - r) / r).powi(2)).sum::<f64>() / pairs.len() as f64).sqrt();
+            let mean = pairs.iter().map(|p| p.0).sum::<f64>() / pairs.iter().map(|p| p.1).sum::<f64>() - 1.0;
+            println!("{sky:?} {material}: {} pixels, relative RMS {:.2}%, mean {:+.2}%", pairs.len(), 100.0 * rms, 100.0 * mean);
+        }
+    }
+}
