@@ -58,22 +58,30 @@ pub fn cube_direction(face: usize, column: usize, row: usize, side: usize) -> DV
 /// The sky's radiance (W/sr/m²) over a cubemap, as half floats.
 fn cubemap(sky: &Sky) -> Image {
     let blue = sky.sun_up().is_some_and(|s| s.normal_irradiance() > 0.0);
-    let mut data = Vec::with_capacity(6 * FACE * FACE * 8);
+    bake_cubemap(FACE, |d| {
+        // Bevy's skybox samples the world direction with z negated (its
+        // cubemaps are left-handed); the model's frame is its world.
+        let direction = d * DVec3::new(1.0, 1.0, -1.0);
+        let radiance = sky.radiance(direction) as f32;
+        let colour = if blue && direction.z > 0.0 { CLEAR_BLUE } else { [1.0; 3] };
+        colour.map(|c| c * radiance)
+    })
+}
+
+/// A cubemap of `side`² texels a face holding `colour` of each texel's
+/// direction (as wgpu samples cubemaps, [`cube_direction`]), as half floats.
+pub(super) fn bake_cubemap(side: usize, colour: impl Fn(DVec3) -> [f32; 3]) -> Image {
+    let mut data = Vec::with_capacity(6 * side * side * 8);
     for face in 0..6 {
-        for row in 0..FACE {
-            for column in 0..FACE {
-                // Bevy's skybox samples the world direction with z negated
-                // (its cubemaps are left-handed); the model's frame is its world.
-                let direction = cube_direction(face, column, row, FACE) * DVec3::new(1.0, 1.0, -1.0);
-                let radiance = sky.radiance(direction) as f32;
-                let colour = if blue && direction.z > 0.0 { CLEAR_BLUE } else { [1.0; 3] };
-                for value in colour.map(|c| c * radiance).into_iter().chain([1.0]) {
+        for row in 0..side {
+            for column in 0..side {
+                for value in colour(cube_direction(face, column, row, side)).into_iter().chain([1.0]) {
                     data.extend_from_slice(&half::f16::from_f32(value).to_le_bytes());
                 }
             }
         }
     }
-    let size = Extent3d { width: FACE as u32, height: FACE as u32, depth_or_array_layers: 6 };
+    let size = Extent3d { width: side as u32, height: side as u32, depth_or_array_layers: 6 };
     let mut image = Image::new(size, TextureDimension::D2, data, TextureFormat::Rgba16Float, RenderAssetUsages::RENDER_WORLD);
     image.texture_view_descriptor = Some(TextureViewDescriptor { dimension: Some(TextureViewDimension::Cube), ..default() });
     image

@@ -173,7 +173,8 @@ impl Material for LightingMaterial {
 
     fn alpha_mode(&self) -> AlphaMode {
         match self.tint.alpha < 1.0 {
-            // A panel adds the light it sends toward the eye to what shows through.
+            // A panel: its own light from the room, its display colour over
+            // what shows through from outside (lighting.wgsl).
             true if self.panel.is_some() => AlphaMode::Premultiplied,
             true => AlphaMode::Blend,
             false => AlphaMode::Opaque,
@@ -198,8 +199,8 @@ impl Material for LightingMaterial {
 }
 
 /// Glass as a faint blue-grey (its alpha is its opacity, 1 − τ), panels
-/// amber: readable at any exposure (a panel adds the light it sends toward
-/// the eye, [`update_panel_looks`]).
+/// amber: readable at any exposure (a panel seen from the room is drawn as
+/// its own light instead, [`update_panel_looks`]).
 const GLASS_TINT: LinearRgba = LinearRgba::new(0.35, 0.45, 0.55, 0.18);
 const PANEL_TINT: LinearRgba = LinearRgba::new(0.7, 0.5, 0.2, 0.3);
 
@@ -283,7 +284,7 @@ pub(super) fn update_panel_looks(
     let looks = model.0.panel_looks(&sun_sky.sky);
     for (panel, material) in &panels {
         let Some(look) = looks.iter().find(|l| l.material == panel.0) else { continue };
-        let sky = panel_sky_cubemap(|outward| model.0.panel_sky_luminance(look, outward));
+        let sky = super::sky::bake_cubemap(PANEL_SKY_FACE, |outward| [model.0.panel_sky_luminance(look, outward) as f32; 3]);
         if let Some(mut material) = materials.get_mut(&material.0) {
             material.panel = Some(PanelLookUniform::new(look, settings.mode));
             match &material.panel_sky {
@@ -299,28 +300,6 @@ pub(super) fn update_panel_looks(
 /// Texels along a side of a panel's sky cubemap: the sky transfer is kept
 /// per sky bin (Reinhart MF:n), a few degrees and more each.
 const PANEL_SKY_FACE: usize = 16;
-
-/// A cubemap (half floats, cd/m²) of `luminance` by the way the eye looks.
-fn panel_sky_cubemap(luminance: impl Fn(crate::glam::DVec3) -> f64) -> Image {
-    use bevy::asset::RenderAssetUsages;
-    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat, TextureViewDescriptor, TextureViewDimension};
-    let side = PANEL_SKY_FACE;
-    let mut data = Vec::with_capacity(6 * side * side * 8);
-    for face in 0..6 {
-        for row in 0..side {
-            for column in 0..side {
-                let value = luminance(super::sky::cube_direction(face, column, row, side)) as f32;
-                for channel in [value, value, value, 1.0] {
-                    data.extend_from_slice(&half::f16::from_f32(channel).to_le_bytes());
-                }
-            }
-        }
-    }
-    let size = Extent3d { width: side as u32, height: side as u32, depth_or_array_layers: 6 };
-    let mut image = Image::new(size, TextureDimension::D2, data, TextureFormat::Rgba16Float, RenderAssetUsages::RENDER_WORLD);
-    image.texture_view_descriptor = Some(TextureViewDescriptor { dimension: Some(TextureViewDimension::Cube), ..default() });
-    image
-}
 
 /// The ground outside, as drawn ([`GroundPlane`]).
 #[derive(Component)]
