@@ -115,14 +115,18 @@ struct Job {
 /// a benchmark drives it with `update()`.
 pub fn offscreen_app(request: &OffscreenRequest) -> App {
     let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
-            .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() })
-            .set(crate::asset_plugin())
-            .disable::<WinitPlugin>()
-            .disable::<LogPlugin>(),
-    );
+    let plugins = DefaultPlugins
+        .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
+        .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() })
+        .set(crate::asset_plugin())
+        .disable::<WinitPlugin>();
+    // Errors only (a shader that fails to build, say), and only where no
+    // logger is set yet: a process drawing many pictures sets it once.
+    app.add_plugins(if bevy::log::tracing::dispatcher::has_been_set() {
+        plugins.disable::<LogPlugin>()
+    } else {
+        plugins.set(LogPlugin { level: bevy::log::Level::ERROR, filter: "error".into(), ..default() })
+    });
     // Direct sun alone needs no light engine: skip its precomputation.
     if request.settings.mode == RenderMode::Sun {
         app.add_plugins(HeliodonPlugins.build().disable::<LightingPlugin>());
