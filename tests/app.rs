@@ -114,6 +114,25 @@ fn a_failed_load_reports_one_line_and_keeps_the_previous_scene() {
     assert_eq!(world.query::<&SceneWindow>().iter(world).count(), 6);
 }
 
+/// A picture that cannot be made says why, in one line: the scene's own
+/// error, not that the renderer stopped.
+#[test]
+fn a_render_that_fails_says_why() {
+    let error = offscreen::render(OffscreenRequest {
+        scene: PathBuf::from("no/such/scene.toml"),
+        view: None,
+        width: 16,
+        height: 16,
+        when: None,
+        sky: None,
+        settings: Default::default(),
+        light: Default::default(),
+        panels: Default::default(),
+    })
+    .expect_err("there is no such scene");
+    assert!(error.contains("no/such/scene.toml") && !error.contains('\n'), "{error}");
+}
+
 #[test]
 fn render_smoke_test_draws_the_model() {
     let request = OffscreenRequest {

@@ -7,6 +7,7 @@
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -15,9 +16,10 @@ use bevy::camera::{Exposure, RenderTarget};
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::log::LogPlugin;
 use bevy::prelude::*;
-use bevy::render::RenderPlugin;
-use bevy::render::render_resource::TextureFormat;
+use bevy::render::render_resource::{CachedPipelineState, PipelineCache, TextureFormat};
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use bevy::render::{Render, RenderApp, RenderPlugin, RenderSystems};
+use bevy::shader::ShaderCacheError;
 use bevy::window::ExitCondition;
 use bevy::winit::WinitPlugin;
 
@@ -107,7 +109,18 @@ struct Job {
     capture_requested: bool,
     picture: Arc<Mutex<Option<Vec<u8>>>>,
     physical: Arc<Mutex<Option<Vec<[f32; 3]>>>>,
-    failure: Option<String>,
+    /// Why no picture will come (shared: the app is gone when `render` reads it).
+    failure: Arc<Mutex<Option<String>>>,
+}
+
+impl Job {
+    fn fail(&self, why: String) {
+        self.failure.lock().expect("offscreen failure lock").get_or_insert(why);
+    }
+
+    fn failed(&self) -> bool {
+        self.failure.lock().expect("offscreen failure lock").is_some()
+    }
 }
 
 /// A headless app that opens the request's scene and draws its view into
@@ -133,6 +146,11 @@ pub fn offscreen_app(request: &OffscreenRequest) -> App {
     } else {
         app.add_plugins(HeliodonPlugins);
     }
+    let failed = PipelineFailed::default();
+    app.insert_resource(failed.clone());
+    if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
+        render_app.insert_resource(failed).add_systems(Render, watch_pipelines.in_set(RenderSystems::Cleanup));
+    }
     app.register_panels(&request.panels);
     app.add_plugins(HeliodonRenderPlugin)
         .insert_resource(request.settings)
@@ -144,7 +162,7 @@ pub fn offscreen_app(request: &OffscreenRequest) -> App {
             capture_requested: false,
             picture: Arc::default(),
             physical: Arc::default(),
-            failure: None,
+            failure: Arc::default(),
         })
         .add_systems(
             Startup,
@@ -171,15 +189,14 @@ pub fn frame_ready(app: &App) -> bool {
 /// Renders one frame of a scene. Errors are one line.
 pub fn render(request: OffscreenRequest) -> Result<RenderedImage, String> {
     let mut app = offscreen_app(&request);
-    let (picture, physical) = {
+    let (picture, physical, failure) = {
         let job = app.world().resource::<Job>();
-        (job.picture.clone(), job.physical.clone())
+        (job.picture.clone(), job.physical.clone(), job.failure.clone())
     };
     app.add_plugins(ScheduleRunnerPlugin::run_loop(Duration::ZERO))
         .add_systems(Update, (capture, finish).chain().after(count_ready_frames))
         .run();
-    let job = app.world_mut().remove_resource::<Job>();
-    if let Some(failure) = job.and_then(|j| j.failure) {
+    if let Some(failure) = failure.lock().expect("offscreen failure lock").take() {
         return Err(failure);
     }
     let rgba = picture.lock().expect("offscreen picture lock").take();
@@ -210,7 +227,7 @@ fn spawn_cameras(
 ) {
     let lighting_failure = light_failed.as_mut().and_then(|m| m.read().last().map(|f| f.message.clone()));
     if let Some(message) = failed.read().last().map(|f| f.message.clone()).or(lighting_failure) {
-        job.failure = Some(message);
+        job.fail(message);
     }
     if spawned.read().last().is_none() {
         return;
@@ -242,12 +259,32 @@ fn light_ready(mode: RenderMode, lighting: Option<&LightingState>, sun_pass: &Su
     }
 }
 
+/// Set from the render world when a pipeline cannot be built at all (a
+/// shader that does not compile): the picture would lack what it draws.
+#[derive(Resource, Clone, Default)]
+struct PipelineFailed(Arc<AtomicBool>);
+
+/// Watches the render world's pipelines for one that failed for good (not
+/// one waiting for its shader to load).
+fn watch_pipelines(cache: Res<PipelineCache>, failed: Res<PipelineFailed>) {
+    let broken = |state: &CachedPipelineState| {
+        matches!(state, CachedPipelineState::Err(ShaderCacheError::ProcessShaderError(_) | ShaderCacheError::CreateShaderModule(_)))
+    };
+    if cache.pipelines().any(|p| broken(&p.state)) {
+        failed.0.store(true, Ordering::Relaxed);
+    }
+}
+
 fn count_ready_frames(
     mut job: ResMut<Job>,
     lighting: Option<Res<LightingState>>,
     sun_pass: Res<SunPassInput>,
     sun_sky: Option<Res<SunSky>>,
+    failed: Res<PipelineFailed>,
 ) {
+    if failed.0.load(Ordering::Relaxed) {
+        job.fail("a shader failed to build (its error is above): the picture would be wrong".into());
+    }
     if job.targets.is_some() && light_ready(job.request.settings.mode, lighting.as_deref(), &sun_pass, sun_sky.as_deref()) {
         job.frames_drawn += 1;
     } else {
@@ -287,7 +324,7 @@ pub fn float_pixels(image: &Image) -> Vec<[f32; 3]> {
 fn finish(job: Res<Job>, mut exit: MessageWriter<AppExit>) {
     let done =
         job.picture.lock().expect("offscreen picture lock").is_some() && job.physical.lock().expect("offscreen physical lock").is_some();
-    if done || job.failure.is_some() {
+    if done || job.failed() {
         exit.write(AppExit::Success);
     }
 }
