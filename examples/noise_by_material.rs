@@ -47,8 +47,7 @@ fn main() {
         })
         .collect();
     let default = LightSettings::default();
-    let converged =
-        LightSettings { rays_per_patch: 16 * default.rays_per_patch, window_rays_per_patch: 16 * default.window_rays_per_patch, ..default };
+    let converged = default.with_more_patch_rays(16);
     for sky in [SkySpec::Overcast, SkySpec::Clear { turbidity: 2.45 }] {
         let draw = |light| {
             render(OffscreenRequest {

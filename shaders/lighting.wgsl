@@ -27,10 +27,10 @@ struct LightingMaterial {
 
 // A panel's look under the sky: the sky and ground it passes into the room
 // by the way the eye looks out through it (panel_sky, cd/m²), the
-// diffusely transmitted sun's luminance (cd/m²), and per lobe the way its light travels into the room (xyz) with
-// the cosine of its cone's half angle (w) and its luminance (x of
-// lobe_luminance): the eye sees a lobe where it looks at the panel from
-// within the cone, against the light.
+// diffusely transmitted sun's luminance (cd/m²), and per lobe the way its
+// light travels into the room (xyz) with the cosine of its cone's half
+// angle (w) and its luminance (x of lobe_luminance): the eye sees a lobe
+// where it looks at the panel from within the cone, against the light.
 struct PanelLook {
     // The panel's normal into the room: the side it looks like this from.
     inward: vec4<f32>,
@@ -83,21 +83,22 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
 #else
     let value = vec3(0.0);
 #endif
-    let to_eye = normalize(view.world_position - in.world_position.xyz);
-    if material.tint.a < 1.0 && material.is_panel == 1u && material.mode == 0u && dot(to_eye, material.panel.inward.xyz) > 0.0 {
-        // Seen from the room, a panel is the light it sends toward the eye:
-        // the sky and ground it passes that way, its diffuse sun, its lobes.
-        var light = material.panel.diffuse + material.panel.sky * textureSampleLevel(panel_sky, panel_sky_sampler, -to_eye, 0.0).r;
-        for (var k = 0u; k < material.panel.lobe_count; k++) {
-            let lobe = material.panel.lobes[k];
-            // A soft rim a thousandth of the cosine wide, against aliasing.
-            light += material.panel.lobe_luminance[k].x * smoothstep(lobe.w - 1e-3, lobe.w, dot(to_eye, lobe.xyz));
-        }
-        // Kept within the half-float target (a lobe seen against its light
-        // may be millions of cd/m²): the physical image saturates there.
-        return vec4(vec3(min(light * view.exposure, MAX_DRAWN)), 1.0);
-    }
     if material.tint.a < 1.0 && material.is_panel == 1u {
+        let to_eye = normalize(view.world_position - in.world_position.xyz);
+        if material.mode == 0u && dot(to_eye, material.panel.inward.xyz) > 0.0 {
+            // Seen from the room, a panel is the light it sends toward the
+            // eye: the sky and ground it passes that way, its diffuse sun,
+            // its lobes.
+            var light = material.panel.diffuse + material.panel.sky * textureSampleLevel(panel_sky, panel_sky_sampler, -to_eye, 0.0).r;
+            for (var k = 0u; k < material.panel.lobe_count; k++) {
+                let lobe = material.panel.lobes[k];
+                // A soft rim a thousandth of the cosine wide, against aliasing.
+                light += material.panel.lobe_luminance[k].x * smoothstep(lobe.w - 1e-3, lobe.w, dot(to_eye, lobe.xyz));
+            }
+            // Kept within the half-float target (a lobe seen against its
+            // light may be millions of cd/m²): the physical image saturates there.
+            return vec4(vec3(min(light * view.exposure, MAX_DRAWN)), 1.0);
+        }
         // From outside, or in false colour: the panel's display colour.
         return vec4(material.tint.rgb * material.tint.a, material.tint.a);
     }

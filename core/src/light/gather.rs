@@ -111,6 +111,11 @@ struct Aim {
 const WINDOW_IN_FRONT: f64 = 1e-4;
 
 impl WindowTarget {
+    /// The solid angle each of its triangles fills seen from `eye`.
+    fn solid_angles(&self, eye: DVec3) -> impl Iterator<Item = f64> + '_ {
+        self.triangles.iter().map(move |t| sampling::solid_angle(eye, &t.0))
+    }
+
     /// A direction from `eye` toward the window and the solid angle its
     /// pdf is one over. From afar, a point drawn on the window by area
     /// (pdf r²/(A cos)); near it, where that weight would swing with 1/r²,
@@ -124,7 +129,7 @@ impl WindowTarget {
             let dir = to / r2.sqrt();
             return Some((dir, self.area * self.normal.dot(dir).abs() / r2));
         }
-        let solid_angles: Vec<f64> = self.triangles.iter().map(|t| sampling::solid_angle(eye, &t.0)).collect();
+        let solid_angles: Vec<f64> = self.solid_angles(eye).collect();
         let total: f64 = solid_angles.iter().sum();
         if total <= 0.0 {
             return None;
@@ -395,7 +400,10 @@ impl LightModel {
         let centre = patch.centroid.as_dvec3();
         let reach = f64::from(patch.area).sqrt() * std::f64::consts::SQRT_2;
         let mut aimed = Vec::new();
-        for (k, target) in targets.iter().enumerate().filter(|_| self.settings.window_rays_per_patch > 0) {
+        if self.settings.window_rays_per_patch == 0 {
+            return aimed;
+        }
+        for (k, target) in targets.iter().enumerate() {
             // Seen from some point of the side: a vertex in front of its plane.
             if !target.triangles.iter().flat_map(|t| t.0).any(|v| normal.dot(v - centre) > WINDOW_IN_FRONT) {
                 continue;
@@ -405,7 +413,7 @@ impl LightModel {
             let cos_here = (normal.dot(to) / distance.max(f64::EPSILON)).max(0.1);
             let near = distance <= target.size.max(reach);
             let solid_angle = if near {
-                target.triangles.iter().map(|t| sampling::solid_angle(centre, &t.0)).sum()
+                target.solid_angles(centre).sum()
             } else {
                 target.area * target.normal.dot(to / distance).abs().max(0.1) / (distance * distance)
             };

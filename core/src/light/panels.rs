@@ -172,6 +172,18 @@ pub enum SkyTransfer {
 }
 
 impl PanelGroup {
+    /// The lobes the panel sends into the room under `sun`, with the
+    /// irradiance its area receives (E · cos θin); none when the sun is
+    /// behind it.
+    fn transmitted_lobes(&self, sun: &SunSource) -> (f64, Vec<Lobe>) {
+        let incoming = self.frame.to_panel(-sun.direction);
+        if incoming.z <= 0.0 {
+            return (0.0, Vec::new());
+        }
+        let lobes = self.model.response(incoming).lobes.into_iter().filter(|l| l.direction.z > 1e-6 && l.share > 0.0).collect();
+        (sun.normal_irradiance() * incoming.z, lobes)
+    }
+
     /// Another model for the group's windows; its sky transfer is made anew.
     pub fn set_model(&mut self, model: Arc<dyn PanelModel>) {
         self.back_reflectance = back_reflectance(model.as_ref());
@@ -352,14 +364,9 @@ impl LightModel {
                     lobes: Vec::new(),
                 };
                 let Some(sun) = &sun else { return look };
-                let incoming = group.frame.to_panel(-sun.direction);
-                if incoming.z <= 0.0 {
-                    return look;
-                }
-                let irradiance = sun.normal_irradiance() * incoming.z * self.panel_sunlit(g, sun.direction);
-                for lobe in
-                    group.model.response(incoming).lobes.iter().filter(|l| l.direction.z > 1e-6 && l.share > 0.0 && irradiance > 0.0)
-                {
+                let (irradiance, lobes) = group.transmitted_lobes(sun);
+                let irradiance = irradiance * self.panel_sunlit(g, sun.direction);
+                for lobe in lobes.iter().filter(|_| irradiance > 0.0) {
                     let direction = lobe.direction.normalize();
                     // (A NaN width reads as narrow, as in `spread`.)
                     let width = if lobe.width.is_nan() { 0.0 } else { lobe.width };
@@ -458,15 +465,12 @@ pub fn spread(lobe: &Lobe) -> Vec<(DVec3, f64)> {
 pub fn sun_beams(groups: &[PanelGroup], sun: &SunSource) -> Vec<SunBeam> {
     let mut beams = vec![SunBeam { to_light: sun.direction, normal_irradiance: sun.normal_irradiance(), panel_group: None }];
     for (index, group) in groups.iter().enumerate() {
-        let incoming = group.frame.to_panel(-sun.direction);
-        if incoming.z <= 0.0 {
-            continue;
-        }
-        for lobe in group.model.response(incoming).lobes.iter().filter(|l| l.direction.z > 1e-6 && l.share > 0.0) {
+        let (irradiance, lobes) = group.transmitted_lobes(sun);
+        for lobe in &lobes {
             for (direction, share) in spread(lobe) {
                 beams.push(SunBeam {
                     to_light: -group.frame.to_world(direction).normalize(),
-                    normal_irradiance: sun.normal_irradiance() * incoming.z * share / direction.z,
+                    normal_irradiance: irradiance * share / direction.z,
                     panel_group: Some(index as u32),
                 });
             }

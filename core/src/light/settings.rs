@@ -65,6 +65,13 @@ impl Default for LightSettings {
 }
 
 impl LightSettings {
+    /// These settings with `factor` times the patch rays (hemisphere and
+    /// aimed at windows): a smoother indirect light, or a converged
+    /// reference to measure the default's noise against.
+    pub fn with_more_patch_rays(self, factor: usize) -> Self {
+        Self { rays_per_patch: self.rays_per_patch * factor, window_rays_per_patch: self.window_rays_per_patch * factor, ..self }
+    }
+
     /// One line naming the first setting that cannot work.
     pub fn check(&self) -> Result<(), String> {
         let positive = [

@@ -52,16 +52,6 @@ pub struct RenderArgs {
     pub quality: u32,
 }
 
-/// The default light settings with `factor` times the patch rays.
-fn more_rays(factor: usize) -> crate::light::LightSettings {
-    let default = crate::light::LightSettings::default();
-    crate::light::LightSettings {
-        rays_per_patch: default.rays_per_patch * factor,
-        window_rays_per_patch: default.window_rays_per_patch * factor,
-        ..default
-    }
-}
-
 fn parse_vertical_section(text: &str) -> Result<VerticalSection, String> {
     let parts: Vec<&str> = text.split(',').collect();
     let [azimuth, offset] = parts[..] else { return Err(format!("'{text}' is not DEG,M")) };
@@ -110,7 +100,7 @@ pub fn run(args: &RenderArgs, panels: &PanelCatalog) -> Result<(), CliError> {
             vertical_section: args.vertical_section,
             ..Default::default()
         },
-        light: more_rays(args.quality as usize),
+        light: crate::light::LightSettings::default().with_more_patch_rays(args.quality as usize),
         panels: panels.clone(),
     })?;
     image.save_png(&args.out)?;
