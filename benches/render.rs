@@ -1,27 +1,58 @@
 //! Frame time of the hybrid renderer, headless on whatever Vulkan device
-//! there is (Mesa's lavapipe on the CI machines): the bundled scenes in full
-//! mode, and a generated hall of 100k triangles with direct sun only (its
-//! sky and indirect light are one vertex-coloured mesh draw; the stencil
-//! passes are what grows with the model). Prints the passes and shadow-volume
-//! triangles drawn per frame.
+//! there is (Mesa's lavapipe on the CI machines), each frame drawn to the end
+//! (the update, then a wait for the device): the bundled scenes and the
+//! rooms with panels in full mode; the large models, a generated hall of 100k triangles (direct sun
+//! alone, where the stencil passes are what grows with the model, and in
+//! full), the furnished floor of offices from its automatic first view and a
+//! room on a 400 × 300 m ground; the office orbiting, orbiting from above
+//! with the section on, and while its light settles. Prints the passes and
+//! shadow-volume triangles drawn per frame.
+//!
+//! 1280 × 720 unless `HELIODON_BENCH_FRAME=WxH` says otherwise (1920x1080
+//! on a GPU machine).
 
+#[path = "../tests/support/office_floor.rs"]
+mod office_floor;
 #[path = "../tests/support/quad_obj.rs"]
 mod quad_obj;
+#[path = "../tests/support/room_on_ground.rs"]
+mod room_on_ground;
 
 use quad_obj::QuadObj;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use bevy::prelude::*;
+use bevy::render::render_resource::PollType;
+use bevy::render::renderer::RenderDevice;
 use criterion::{Criterion, criterion_group, criterion_main};
+use heliodon::ecs::ActiveScene;
+use heliodon::panel::PanelCatalog;
 use heliodon::render::offscreen::{OffscreenRequest, frame_ready, offscreen_app};
 use heliodon::render::sun_pass::SunPassInput;
-use heliodon::render::{RenderMode, RenderSettings};
+use heliodon::render::{PhysicalUnits, RenderMode, RenderSettings, framing};
 use heliodon::sky::SkySpec;
 use heliodon::time::{Date, LocalDateTime, TimeOfDay};
 
-const WIDTH: u32 = 1280;
-const HEIGHT: u32 = 720;
+/// The bundled rooms with panels: one lobe pass pair per fake sun.
+const PANEL_ROOMS: &[&str] = &["prismatic_room", "laser_cut_room", "venetian_room", "bsdf_room"];
+
+/// The frame's size: `HELIODON_BENCH_FRAME=WxH`, or 1280 × 720.
+fn frame_size() -> (u32, u32) {
+    let size = std::env::var("HELIODON_BENCH_FRAME").ok().and_then(|text| {
+        let (w, h) = text.split_once('x')?;
+        Some((w.trim().parse().ok()?, h.trim().parse().ok()?))
+    });
+    size.unwrap_or((1280, 720))
+}
+
+/// One frame drawn to the end: the app's update, then a wait until the
+/// device has done what it was given (an offscreen target has no swap chain
+/// to hold the next frame back, so the update alone times the CPU's part).
+fn draw(app: &mut App) {
+    app.update();
+    let _ = app.world().resource::<RenderDevice>().poll(PollType::wait_indefinitely());
+}
 
 /// A 60 × 40 m hall with a glazed south façade and 8,400 boxes (desks,
 /// cabinets) on its floor: about 100k triangles.
@@ -64,22 +95,36 @@ fn hall(dir: &Path) -> PathBuf {
 
 /// A warmed-up app drawing `scene`'s first camera, and what the sun pass draws per frame.
 fn ready_app(scene: PathBuf, mode: RenderMode) -> (App, String) {
+    let (width, height) = frame_size();
     let request = OffscreenRequest {
         scene,
         view: None,
-        width: WIDTH,
-        height: HEIGHT,
+        width,
+        height,
         when: Some(LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(10.0).unwrap() }),
         sky: Some(SkySpec::Clear { turbidity: 2.45 }),
         settings: RenderSettings { mode, ..Default::default() },
         light: Default::default(),
-        panels: Default::default(),
+        panels: PanelCatalog::new()
+            .with(heliodon_prismatic::Prismatic)
+            .with(heliodon_laser_cut::LaserCut)
+            .with(heliodon_venetian::Venetian)
+            .with(heliodon_bsdf::Bsdf),
     };
     let mut app = offscreen_app(&request);
     app.finish();
     app.cleanup();
+    let start = std::time::Instant::now();
     while !frame_ready(&app) {
+        // A scene that fails to load never gets ready (Bevy has logged why).
+        assert!(start.elapsed() < Duration::from_secs(300), "{}: not ready after 300 s", request.scene.display());
         app.update();
+    }
+    // The viewer draws one view; the offscreen app has a second camera
+    // writing physical values beside the picture, which the frame time leaves out.
+    let mut physical = app.world_mut().query_filtered::<&mut Camera, With<PhysicalUnits>>();
+    for mut camera in physical.iter_mut(app.world_mut()) {
+        camera.is_active = false;
     }
     let counts = match &app.world().resource::<SunPassInput>().0 {
         Some(frame) => format!(
@@ -98,28 +143,67 @@ fn ready_app(scene: PathBuf, mode: RenderMode) -> (App, String) {
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("render");
     group.sample_size(10).measurement_time(Duration::from_secs(15));
-    let mut cases: Vec<(String, PathBuf, RenderMode)> =
-        heliodon::BUNDLED_SCENES.iter().map(|name| (format!("{name} full"), heliodon::bundled_scene(name), RenderMode::Full)).collect();
-    cases.push(("hall 100k triangles sun".into(), hall(&std::env::temp_dir().join("heliodon-bench-hall")), RenderMode::Sun));
+    let (width, height) = frame_size();
+    let temp = std::env::temp_dir();
+    let mut cases: Vec<(String, PathBuf, RenderMode)> = heliodon::BUNDLED_SCENES
+        .iter()
+        .chain(PANEL_ROOMS)
+        .map(|name| (format!("{name} full"), heliodon::bundled_scene(name), RenderMode::Full))
+        .collect();
+    let hall = hall(&temp.join("heliodon-bench-hall"));
+    cases.push(("hall 100k triangles sun".into(), hall.clone(), RenderMode::Sun));
+    cases.push(("hall 100k triangles full".into(), hall, RenderMode::Full));
+    let floor = office_floor::office_floor(&temp.join("heliodon-bench-furnished-floor"), true);
+    cases.push(("furnished office floor full".into(), floor, RenderMode::Full));
+    let ground = room_on_ground::room_on_a_ground(&temp.join("heliodon-bench-room-on-ground"), 400.0, 300.0, true);
+    cases.push(("room on a 400 x 300 m ground full".into(), ground, RenderMode::Full));
     for (label, scene, mode) in cases {
         let (mut app, counts) = ready_app(scene, mode);
         println!("{label}: {counts}");
-        group.bench_function(format!("frame {label} {WIDTH}x{HEIGHT}"), |b| b.iter(|| app.update()));
+        group.bench_function(format!("frame {label} {width}x{height}"), |b| b.iter(|| draw(&mut app)));
     }
+    orbiting(&mut group);
     settling(&mut group);
     group.finish();
+}
+
+/// The office while the camera orbits (half a degree a frame about the
+/// vertical through the middle of what matters): from its own camera, and
+/// from above with the section on (cut 2.5 m over the floor).
+fn orbiting(group: &mut criterion::BenchmarkGroup<criterion::measurement::WallTime>) {
+    let (width, height) = frame_size();
+    let (mut app, _) = ready_app(heliodon::bundled_scene("office"), RenderMode::Full);
+    let focus = app.world().resource::<ActiveScene>().scene.as_ref().expect("the office is loaded").focus;
+    let (centre, distance) = framing(focus, heliodon::scene::DEFAULT_FOV);
+    let turn = Quat::from_rotation_z(0.5f32.to_radians());
+    let orbit = |app: &mut App| {
+        let mut cameras = app.world_mut().query_filtered::<&mut Transform, With<Camera3d>>();
+        for mut transform in cameras.iter_mut(app.world_mut()) {
+            transform.rotate_around(centre, turn);
+        }
+        draw(app);
+    };
+    group.bench_function(format!("frame office full orbiting {width}x{height}"), |b| b.iter(|| orbit(&mut app)));
+    let above = centre + distance * Vec3::new(0.0, -0.5, 0.85).normalize();
+    let mut cameras = app.world_mut().query_filtered::<&mut Transform, With<Camera3d>>();
+    for mut transform in cameras.iter_mut(app.world_mut()) {
+        *transform = Transform::from_translation(above).looking_at(centre, Vec3::Z);
+    }
+    app.world_mut().resource_mut::<RenderSettings>().section = Some(focus.0.z + 2.5);
+    group.bench_function(format!("frame office full orbiting from above, section on {width}x{height}"), |b| b.iter(|| orbit(&mut app)));
 }
 
 /// The office while its light settles: frames drawn while relights run
 /// (each converged relight is followed by a new time, ten minutes on), and
 /// the frames around a material edit (respawn and a new precomputation).
 fn settling(group: &mut criterion::BenchmarkGroup<criterion::measurement::WallTime>) {
-    use heliodon::ecs::{ActiveScene, EditMaterial, LightingState, SolarTime};
+    use heliodon::ecs::{EditMaterial, LightingState, SolarTime};
     use std::time::Instant;
+    let (width, height) = frame_size();
     let (mut app, _) = ready_app(heliodon::bundled_scene("office"), RenderMode::Full);
     let converged = |app: &App| app.world().get_resource::<LightingState>().is_some_and(|l| l.converged);
     let mut relights = 0u32;
-    group.bench_function(format!("frame office full while the light settles {WIDTH}x{HEIGHT}"), |b| {
+    group.bench_function(format!("frame office full while the light settles {width}x{height}"), |b| {
         b.iter_custom(|iters| {
             let mut total = Duration::ZERO;
             for _ in 0..iters {
@@ -130,7 +214,7 @@ fn settling(group: &mut criterion::BenchmarkGroup<criterion::measurement::WallTi
                     relights += 1;
                 }
                 let start = Instant::now();
-                app.update();
+                draw(&mut app);
                 total += start.elapsed();
             }
             total
@@ -145,7 +229,7 @@ fn settling(group: &mut criterion::BenchmarkGroup<criterion::measurement::WallTi
     let start = Instant::now();
     while frames.is_empty() || !converged(&app) || frames.len() < 3 {
         let frame = Instant::now();
-        app.update();
+        draw(&mut app);
         frames.push(frame.elapsed().as_secs_f64() * 1e3);
     }
     let worst = frames.iter().copied().fold(0.0, f64::max);

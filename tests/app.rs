@@ -457,6 +457,45 @@ fn relights_run_as_tasks_and_the_last_change_wins() {
     }
 }
 
+/// The viewer's light (`RefineForDisplay`): the light of the settings is
+/// shown first, then a precomputation with the display's patch rays runs in
+/// the background, and the light shown is that smoothed model's, as a fresh
+/// solve gives it; the settings' own model stays for the numbers.
+#[test]
+fn the_light_shown_is_smoothed_after_it_appears() {
+    use heliodon::ecs::{self, LightCacheDir, LightEngine, LightingState, RefineForDisplay, SunSky};
+
+    let base = quick_light();
+    let mut app = headless_app();
+    app.insert_resource(ecs::LightSettings(base)).insert_resource(LightCacheDir(None)).insert_resource(RefineForDisplay(true));
+    open(&mut app, heliodon::bundled_scene("test_room")).unwrap();
+    let (mut shown_first, mut smoothed_after) = (false, false);
+    let deadline = Instant::now() + Duration::from_secs(120);
+    loop {
+        app.update();
+        let world = app.world();
+        let (engine, state) = (world.resource::<LightEngine>(), world.resource::<LightingState>());
+        shown_first |= state.converged && engine.model.is_some() && engine.smoothed.is_none() && engine.is_smoothing();
+        smoothed_after |= shown_first && engine.smoothed.is_some();
+        if smoothed_after && !engine.is_smoothing() && !engine.is_settling(state) {
+            break;
+        }
+        assert!(Instant::now() < deadline, "the light was not smoothed in time (shown first: {shown_first})");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let world = app.world();
+    let engine = world.resource::<LightEngine>();
+    assert_eq!(engine.model.as_ref().unwrap().settings, base, "the numbers' model");
+    let model = engine.smoothed.clone().unwrap();
+    assert_eq!(model.settings, base.for_display(model.scene.patches.patches.len()));
+    assert_eq!(model.settings.rays_per_patch, 2048, "a room's picture takes 8 times the default patch rays");
+    let fresh = model.solve(&world.resource::<SunSky>().sky, None);
+    let shown = world.resource::<LightingState>().lighting.clone().unwrap();
+    for (a, b) in shown.sides.iter().zip(&fresh.sides) {
+        assert!((a.indirect[1] - b.indirect[1]).abs() <= 1e-3 * b.indirect[1].max(1.0), "{a:?} vs {b:?}");
+    }
+}
+
 /// Renders the direct sun of a view and compares it with the CPU reference
 /// (`render::reference`); the picture and its disagreement map go to the
 /// test's temporary folder.

@@ -3,7 +3,14 @@
 //! [`LightChanged`] (or a finished precomputation) starts a relight task that
 //! sends each finished iteration back, so the view can show the light
 //! settling. A newer relight supersedes the running one: the old task stops
-//! at its next iteration, and its results are never applied.
+//! at its next iteration, and its results are never applied. Where the light
+//! is refined for display ([`RefineForDisplay`], the viewer), a second
+//! precomputation with more patch rays follows once the first light is
+//! shown, in the background, and the light shown comes from it when done:
+//! the light appears as fast as before and then loses its Monte Carlo
+//! blotches. The settings' own model stays what the numbers come from (a
+//! sensor's day and year, the annual study, sweeps), as `sensors` and
+//! `annual` compute them.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, channel};
@@ -20,6 +27,7 @@ pub struct LightingPlugin;
 impl Plugin for LightingPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<LightSettings>()
+            .init_resource::<RefineForDisplay>()
             .init_resource::<LightCacheDir>()
             .init_resource::<LightEngine>()
             .init_resource::<LightingState>()
@@ -27,7 +35,9 @@ impl Plugin for LightingPlugin {
             .add_message::<LightingFailed>()
             .add_systems(
                 Update,
-                (start_precompute, finish_precompute, start_relight, apply_relight).chain().in_set(HeliodonSystems::Lighting),
+                (start_precompute, finish_precompute, start_relight, apply_relight, start_refinement)
+                    .chain()
+                    .in_set(HeliodonSystems::Lighting),
             );
     }
 }
@@ -36,6 +46,13 @@ impl Plugin for LightingPlugin {
 /// [`light::LightSettings`], as a resource).
 #[derive(Resource, Debug, Clone, Copy, Default, PartialEq)]
 pub struct LightSettings(pub light::LightSettings);
+
+/// Whether the light shown is refined past [`LightSettings`]' patch rays
+/// ([`light::LightSettings::for_display`]) once its first light is shown.
+/// The first precomputation keeps the settings as `sensors` and `annual`
+/// use them (and their light cache).
+#[derive(Resource, Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RefineForDisplay(pub bool);
 
 /// Where precomputations are cached (`None`: not at all).
 #[derive(Resource, Debug, Clone, PartialEq)]
@@ -50,9 +67,17 @@ impl Default for LightCacheDir {
 /// The precomputed model and the work in flight.
 #[derive(Resource, Default)]
 pub struct LightEngine {
-    /// The model of the active scene, once precomputed.
+    /// The model of the active scene with the settings as they are, once
+    /// precomputed.
     pub model: Option<Arc<LightModel>>,
+    /// The same with the display's patch rays, once precomputed
+    /// ([`RefineForDisplay`]): the light shown comes from it.
+    pub smoothed: Option<Arc<LightModel>>,
     precompute: Option<Task<Result<LightModel, String>>>,
+    /// The precomputation for display that follows the one in flight.
+    refinement: Option<(Arc<crate::scene::Scene>, light::LightSettings)>,
+    /// Whether the precomputation in flight is that refinement.
+    refining: bool,
     /// Generation of the newest relight; older tasks stop when they see it move on.
     generation: Arc<AtomicU64>,
     results: Option<Mutex<Receiver<RelightResult>>>,
@@ -65,13 +90,20 @@ impl LightEngine {
         self.precompute.is_some()
     }
 
+    /// Whether the light is yet to be refined for display (its model
+    /// precomputed again with more patch rays), or being refined.
+    pub fn is_smoothing(&self) -> bool {
+        self.refinement.is_some() || (self.precompute.is_some() && self.refining)
+    }
+
     /// The newest relight's generation: results of older ones are dropped.
     pub fn generation(&self) -> u64 {
         self.generation.load(Ordering::SeqCst)
     }
 
-    /// Whether the light is still on its way to `state`: precomputing, a
-    /// relight asked for, or the newest relight not yet shown converged.
+    /// Whether the light is still on its way to `state`: precomputing (for
+    /// display too), a relight asked for, or the newest relight not yet
+    /// shown converged.
     pub fn is_settling(&self, state: &LightingState) -> bool {
         self.is_precomputing()
             || self.relight_pending
@@ -112,6 +144,7 @@ fn start_precompute(
     mut spawned: MessageReader<SceneSpawned>,
     active: Res<ActiveScene>,
     settings: Res<LightSettings>,
+    refine: Res<RefineForDisplay>,
     cache_dir: Res<LightCacheDir>,
     mut engine: ResMut<LightEngine>,
     mut state: ResMut<LightingState>,
@@ -122,14 +155,24 @@ fn start_precompute(
     let Some(scene) = active.scene.clone() else { return };
     let settings = settings.0;
     engine.model = None;
+    engine.smoothed = None;
     engine.results = None;
     engine.generation.fetch_add(1, Ordering::SeqCst);
     *state = LightingState::default();
+    let display = settings.for_display(scene.patches.patches.len());
+    engine.refinement = (refine.0 && display != settings).then(|| (scene.clone(), display));
+    engine.refining = false;
+    engine.precompute = Some(precompute_task(scene, settings, &cache_dir));
+}
+
+fn precompute_task(
+    scene: Arc<crate::scene::Scene>,
+    settings: light::LightSettings,
+    cache_dir: &LightCacheDir,
+) -> Task<Result<LightModel, String>> {
     let dir = cache_dir.0.clone();
-    engine.precompute = Some(
-        AsyncComputeTaskPool::get()
-            .spawn(async move { cache::precompute_cached(scene, settings, dir.as_deref(), &|_| {}).map(|(model, _)| model) }),
-    );
+    AsyncComputeTaskPool::get()
+        .spawn(async move { cache::precompute_cached(scene, settings, dir.as_deref(), &|_| {}).map(|(model, _)| model) })
 }
 
 fn finish_precompute(mut engine: ResMut<LightEngine>, mut failed: MessageWriter<LightingFailed>) {
@@ -138,12 +181,32 @@ fn finish_precompute(mut engine: ResMut<LightEngine>, mut failed: MessageWriter<
     engine.precompute = None;
     match result {
         Ok(model) => {
-            engine.model = Some(Arc::new(model));
+            let model = Some(Arc::new(model));
+            if engine.refining {
+                engine.smoothed = model
+            } else {
+                engine.model = model
+            }
             engine.relight_pending = true;
+            engine.refining = false;
         }
         Err(message) => {
+            engine.refinement = None;
             failed.write(LightingFailed { message });
         }
+    }
+}
+
+/// Starts the precomputation for display once the first light is shown
+/// (converged), so that it never holds that light back.
+fn start_refinement(state: Res<LightingState>, cache_dir: Res<LightCacheDir>, mut engine: ResMut<LightEngine>) {
+    let shown = state.converged && state.generation == engine.generation() && !engine.relight_pending;
+    if engine.precompute.is_some() || !shown {
+        return;
+    }
+    if let Some((scene, settings)) = engine.refinement.take() {
+        engine.precompute = Some(precompute_task(scene, settings, &cache_dir));
+        engine.refining = true;
     }
 }
 
@@ -156,7 +219,7 @@ fn start_relight(
     if changed.read().last().is_some() {
         engine.relight_pending = true;
     }
-    let (Some(model), Some(sun_sky)) = (engine.model.clone(), sun_sky) else { return };
+    let (Some(model), Some(sun_sky)) = (engine.smoothed.clone().or_else(|| engine.model.clone()), sun_sky) else { return };
     if !engine.relight_pending {
         return;
     }

@@ -12,7 +12,9 @@ mod sun_sky;
 use bevy::app::PluginGroupBuilder;
 use bevy::prelude::*;
 
-pub use lighting::{LightCacheDir, LightEngine, LightSettings, LightingFailed, LightingPlugin, LightingState, LightingUpdated};
+pub use lighting::{
+    LightCacheDir, LightEngine, LightSettings, LightingFailed, LightingPlugin, LightingState, LightingUpdated, RefineForDisplay,
+};
 pub use scene_asset::{PanelRegistry, RegisterPanel, SceneAsset, SceneLoader, describe_load_failure, scene_asset_path};
 pub use scene_plugin::{
     ActiveScene, EditMaterial, GiveOwnMaterial, MaterialEditRejected, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, ScenePlugin,

@@ -11,7 +11,7 @@ use bevy::prelude::*;
 use super::annual::{AnnualStudy, Metric};
 use super::capture::{SaveResults, SaveView};
 use super::sensors::{DaySeries, SelectedSensor, YearMap};
-use crate::ecs::{ActiveScene, HeliodonSystems, LightingState, SceneSpawned, SkyChoice, SolarTime};
+use crate::ecs::{ActiveScene, HeliodonSystems, LightEngine, LightingState, SceneSpawned, SkyChoice, SolarTime};
 
 /// Starts the viewer as [`ViewStart`] says, when that resource is there.
 pub struct BatchPlugin;
@@ -140,6 +140,7 @@ const SETTLE_FRAMES: u32 = 10;
 fn take_screenshot(
     request: Option<Res<ViewStart>>,
     lighting: Option<Res<LightingState>>,
+    engine: Option<Res<LightEngine>>,
     selected: Res<SelectedSensor>,
     day: Res<DaySeries>,
     year: Res<YearMap>,
@@ -159,7 +160,9 @@ fn take_screenshot(
         // The light has converged, and the selected sensor's day (and year) are in.
         let plots_in = selected.0.is_none() || (day.0.values.is_some() && (!request.year || year.map.values.is_some()));
         let year_in = !request.annual || study.result.values.is_some();
-        *frames = if lighting.is_some_and(|l| l.converged) && plots_in && year_in { *frames + 1 } else { 0 };
+        let light_in =
+            lighting.as_deref().is_some_and(|l| l.converged && engine.as_deref().is_none_or(|e| !e.is_settling(l) && !e.is_smoothing()));
+        *frames = if light_in && plots_in && year_in { *frames + 1 } else { 0 };
         if *frames == SETTLE_FRAMES {
             saves.write_batch(wanted);
             match &study.result.values {

@@ -86,6 +86,9 @@ impl Plugin for ViewerPlugin {
             Update,
             (frame_new_scene.before(ViewerSystems::Camera), title_names_the_scene, failed_load).after(HeliodonSystems::SpawnScene),
         )
+        // The light appears as soon as the settings' own precomputation is
+        // in, then smooths as the display's one replaces it.
+        .insert_resource(crate::ecs::RefineForDisplay(true))
         .init_resource::<focus::PanelFocus>()
         .init_resource::<widgets::Note>()
         .add_plugins((

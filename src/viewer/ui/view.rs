@@ -140,10 +140,12 @@ fn view_panel(
         false_colour_legend(ui, settings.false_colour_max_lux);
     }
     let progress = match (engine, lighting) {
-        (Some(e), _) if e.is_precomputing() => "precomputing the light…".to_string(),
+        (Some(e), _) if e.is_precomputing() && e.model.is_none() => "precomputing the light…".to_string(),
         (_, Some(l)) if l.lighting.is_some() => {
             let (iterations, residual) = l.lighting.as_ref().map_or((0, f64::INFINITY), |x| (x.iterations, x.residual));
-            if l.converged {
+            if engine.is_some_and(LightEngine::is_smoothing) {
+                "light shown; smoothing it with more rays…".to_string()
+            } else if l.converged {
                 format!("light converged ({iterations} iterations, residual {residual:.1e})")
             } else {
                 format!("light settling… iteration {iterations}, residual {residual:.1e}")
