@@ -460,7 +460,7 @@ fn relights_run_as_tasks_and_the_last_change_wins() {
 /// The viewer's light (`RefineForDisplay`): the light of the settings is
 /// shown first, then a precomputation with the display's patch rays runs in
 /// the background, and the light shown is that smoothed model's, as a fresh
-/// solve gives it; the settings' own model stays for the numbers.
+/// solve gives it; the sensors read as the settings' own model gives them.
 #[test]
 fn the_light_shown_is_smoothed_after_it_appears() {
     use heliodon::ecs::{self, LightCacheDir, LightEngine, LightingState, RefineForDisplay, SunSky};
@@ -489,11 +489,16 @@ fn the_light_shown_is_smoothed_after_it_appears() {
     let model = engine.smoothed.clone().unwrap();
     assert_eq!(model.settings, base.for_display(model.scene.patches.patches.len()));
     assert_eq!(model.settings.rays_per_patch, 2048, "a room's picture takes 8 times the default patch rays");
-    let fresh = model.solve(&world.resource::<SunSky>().sky, None);
+    let sky = &world.resource::<SunSky>().sky;
+    let fresh = model.solve(sky, None);
     let shown = world.resource::<LightingState>().lighting.clone().unwrap();
     for (a, b) in shown.sides.iter().zip(&fresh.sides) {
         assert!((a.indirect[1] - b.indirect[1]).abs() <= 1e-3 * b.indirect[1].max(1.0), "{a:?} vs {b:?}");
     }
+    // The sensors read as `sensors` reads them, and not as the smoothed model would.
+    let numbers = engine.model.as_ref().unwrap().solve(sky, None);
+    assert_eq!(shown.sensors, numbers.sensors);
+    assert!(shown.sensors.iter().zip(&fresh.sensors).any(|(a, b)| a.total != b.total));
 }
 
 /// Renders the direct sun of a view and compares it with the CPU reference

@@ -8,9 +8,9 @@
 //! precomputation with more patch rays follows once the first light is
 //! shown, in the background, and the light shown comes from it when done:
 //! the light appears as fast as before and then loses its Monte Carlo
-//! blotches. The settings' own model stays what the numbers come from (a
-//! sensor's day and year, the annual study, sweeps), as `sensors` and
-//! `annual` compute them.
+//! blotches. The settings' own model stays what the numbers come from (the
+//! sensors' readings, a sensor's day and year, the annual study, sweeps),
+//! as `sensors` and `annual` compute them.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, channel};
@@ -228,6 +228,9 @@ fn start_relight(
     let current = engine.generation.clone();
     let sky = sun_sky.sky.clone();
     let warm = state.lighting.clone();
+    // Where the light shown is the smoothed model's, the converged sensors
+    // still read as `sensors` reads them: from the settings' own model.
+    let numbers = engine.smoothed.as_ref().and(engine.model.clone());
     let (sender, receiver) = channel();
     engine.results = Some(Mutex::new(receiver));
     AsyncComputeTaskPool::get()
@@ -235,8 +238,12 @@ fn start_relight(
             let mut relight = model.relight(&sky, warm.as_ref());
             loop {
                 let converged = relight.is_converged();
+                let mut lighting = relight.lighting();
+                if converged && let Some(numbers) = &numbers {
+                    lighting.sensors = numbers.solve(&sky, None).sensors;
+                }
                 if current.load(Ordering::SeqCst) != generation
-                    || sender.send(RelightResult { generation, lighting: relight.lighting(), converged }).is_err()
+                    || sender.send(RelightResult { generation, lighting, converged }).is_err()
                     || converged
                 {
                     return;
