@@ -165,6 +165,7 @@ fn start_precompute(
     engine.precompute = Some(precompute_task(scene, settings, &cache_dir));
 }
 
+/// The precomputation of `scene` with `settings` (or its cached model) as a task.
 fn precompute_task(
     scene: Arc<crate::scene::Scene>,
     settings: light::LightSettings,
@@ -192,6 +193,7 @@ fn finish_precompute(mut engine: ResMut<LightEngine>, mut failed: MessageWriter<
         }
         Err(message) => {
             engine.refinement = None;
+            engine.refining = false;
             failed.write(LightingFailed { message });
         }
     }
