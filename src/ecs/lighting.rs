@@ -74,10 +74,9 @@ pub struct LightEngine {
     /// ([`RefineForDisplay`]): the light shown comes from it.
     pub smoothed: Option<Arc<LightModel>>,
     precompute: Option<Task<Result<LightModel, String>>>,
-    /// The precomputation for display that follows the one in flight.
+    /// The precomputation for display still to start (once the first
+    /// light is shown). One in flight while `model` is there is it.
     refinement: Option<(Arc<crate::scene::Scene>, light::LightSettings)>,
-    /// Whether the precomputation in flight is that refinement.
-    refining: bool,
     /// Generation of the newest relight; older tasks stop when they see it move on.
     generation: Arc<AtomicU64>,
     results: Option<Mutex<Receiver<RelightResult>>>,
@@ -93,7 +92,7 @@ impl LightEngine {
     /// Whether the light is yet to be refined for display (its model
     /// precomputed again with more patch rays), or being refined.
     pub fn is_smoothing(&self) -> bool {
-        self.refinement.is_some() || (self.precompute.is_some() && self.refining)
+        self.refinement.is_some() || (self.precompute.is_some() && self.model.is_some())
     }
 
     /// The newest relight's generation: results of older ones are dropped.
@@ -161,7 +160,6 @@ fn start_precompute(
     *state = LightingState::default();
     let display = settings.for_display(scene.patches.patches.len());
     engine.refinement = (refine.0 && display != settings).then(|| (scene.clone(), display));
-    engine.refining = false;
     engine.precompute = Some(precompute_task(scene, settings, &cache_dir));
 }
 
@@ -182,18 +180,17 @@ fn finish_precompute(mut engine: ResMut<LightEngine>, mut failed: MessageWriter<
     engine.precompute = None;
     match result {
         Ok(model) => {
+            // The settings' own model lands first; the refinement starts after it.
             let model = Some(Arc::new(model));
-            if engine.refining {
+            if engine.model.is_some() {
                 engine.smoothed = model
             } else {
                 engine.model = model
             }
             engine.relight_pending = true;
-            engine.refining = false;
         }
         Err(message) => {
             engine.refinement = None;
-            engine.refining = false;
             failed.write(LightingFailed { message });
         }
     }
@@ -208,7 +205,6 @@ fn start_refinement(state: Res<LightingState>, cache_dir: Res<LightCacheDir>, mu
     }
     if let Some((scene, settings)) = engine.refinement.take() {
         engine.precompute = Some(precompute_task(scene, settings, &cache_dir));
-        engine.refining = true;
     }
 }
 
