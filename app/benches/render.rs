@@ -11,23 +11,22 @@
 //! 1280 × 720 unless `HELIODON_BENCH_FRAME=WxH` says otherwise (1920x1080
 //! on a GPU machine).
 
-#[path = "../tests/support/office_floor.rs"]
+#[path = "../../tests/support/office_floor.rs"]
 mod office_floor;
-#[path = "../tests/support/quad_obj.rs"]
+#[path = "../../tests/support/quad_obj.rs"]
 mod quad_obj;
-#[path = "../tests/support/room_on_ground.rs"]
+#[path = "../../tests/support/room_on_ground.rs"]
 mod room_on_ground;
 
 use quad_obj::QuadObj;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use bevy::prelude::*;
-use bevy::render::render_resource::PollType;
-use bevy::render::renderer::RenderDevice;
 use criterion::{Criterion, criterion_group, criterion_main};
+use heliodon::bevy::prelude::*;
+use heliodon::bevy::render::render_resource::PollType;
+use heliodon::bevy::render::renderer::RenderDevice;
 use heliodon::ecs::ActiveScene;
-use heliodon::panel::PanelCatalog;
 use heliodon::render::offscreen::{OffscreenRequest, frame_ready, offscreen_app};
 use heliodon::render::sun_pass::SunPassInput;
 use heliodon::render::{PhysicalUnits, RenderMode, RenderSettings, framing};
@@ -105,11 +104,7 @@ fn ready_app(scene: PathBuf, mode: RenderMode) -> (App, String) {
         sky: Some(SkySpec::Clear { turbidity: 2.45 }),
         settings: RenderSettings { mode, ..Default::default() },
         light: Default::default(),
-        panels: PanelCatalog::new()
-            .with(heliodon_prismatic::Prismatic)
-            .with(heliodon_laser_cut::LaserCut)
-            .with(heliodon_venetian::Venetian)
-            .with(heliodon_bsdf::Bsdf),
+        panels: heliodon_app::builtin_panels(),
     };
     let mut app = offscreen_app(&request);
     app.finish();

@@ -3,17 +3,6 @@
 
 use std::process::ExitCode;
 
-use heliodon::panel::PanelCatalog;
-
-/// The built-in panels, registered the way any app registers panel types.
-fn builtin_panels() -> PanelCatalog {
-    PanelCatalog::new()
-        .with(heliodon_prismatic::Prismatic)
-        .with(heliodon_laser_cut::LaserCut)
-        .with(heliodon_venetian::Venetian)
-        .with(heliodon_bsdf::Bsdf)
-}
-
 fn main() -> ExitCode {
-    heliodon::cli::main(builtin_panels())
+    heliodon::cli::main(heliodon_app::builtin_panels())
 }
