@@ -22,7 +22,7 @@ use heliodon_core::sun::solar_position;
 use heliodon_core::time::{Date, LocalDateTime, TimeOfDay};
 
 use cli::{Run, heliodon, root};
-use epw::boston_epw;
+use epw::{boston_clear_thirds_epw, boston_epw};
 use fixture::{OBJ, fixture, scene_toml};
 
 /// A light cache for the commands whose caching is not what is tested.
@@ -752,10 +752,15 @@ fn sweeps_read_what_scene_files_with_those_keys_read() {
 }
 
 /// Over a year a sweep's DA300 and sDA are what `annual` gives for a scene
-/// file with those keys; the picture is written.
+/// file with those keys, within the contract's 0.5% (the sweep reads its
+/// lobes' bounces from lobe coefficients, `annual` traces them hour by
+/// hour), over a year with thousands of sunny hours; the picture is written.
 #[test]
 fn sweeps_against_a_year_read_what_annual_reads() {
-    let (dir, epw) = folder_with_a_year("sweep_year");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sweep_year");
+    std::fs::create_dir_all(&dir).unwrap();
+    let epw = dir.join("clear_thirds.epw");
+    std::fs::write(&epw, boston_clear_thirds_epw()).unwrap();
     let picture = dir.join("curve.png");
     let room = bundled_scene("prismatic_room");
     let args = ["sweep", room.to_str().unwrap(), "--material", "upper", "--vary", "facet_angles[0]=30..50:20", "--all-sensors"];
@@ -776,6 +781,7 @@ fn sweeps_against_a_year_read_what_annual_reads() {
         .filter_map(|l| l.strip_prefix("50,"))
         .map(|l| l.rsplit_once(',').map(|(s, v)| (s, v.parse().unwrap())).unwrap())
         .collect();
+    let mut worst: f64 = 0.0;
     for (sensor, value) in &swept {
         let expected = if *sensor == "sDA300/50%" {
             year.split("\"sda300_50\": ").nth(1).unwrap().split(',').next().unwrap().parse::<f64>().unwrap()
@@ -783,8 +789,10 @@ fn sweeps_against_a_year_read_what_annual_reads() {
             let at = year.find(&format!("\"name\": \"{sensor}\", \"da300\": ")).unwrap_or_else(|| panic!("{sensor} in {year}"));
             year[at..].split("\"da300\": ").nth(1).unwrap().split(',').next().unwrap().parse().unwrap()
         };
-        assert!((value - expected).abs() <= 0.05, "{sensor}: sweep {value} vs annual {expected}");
+        worst = worst.max((value - expected).abs());
+        assert!((value - expected).abs() <= 0.005 * expected, "{sensor}: sweep {value} vs annual {expected}");
     }
+    println!("largest difference {worst} percentage points");
     assert!(swept.iter().any(|s| s.0 == "sDA300/50%") && swept.len() > 5, "{out}");
 }
 

@@ -20,18 +20,30 @@
 //!    model is swapped ([`LightModel::set_panel_model`]; the coefficients
 //!    are solved again only where a combination changes how much light the
 //!    panel reflects back into the room). At an instant a
-//!    combination is one coefficient reading; over a year one sun path and
-//!    a year of readings. A glass's transmittance changes every ray that
-//!    crosses it: each combination is precomputed anew.
+//!    combination is one coefficient reading. A glass's transmittance
+//!    changes every ray that crosses it: each combination is precomputed
+//!    anew.
+//! 4. **A year** ([`SweptYear`]): what does not pass the panel (the sun
+//!    through glass, other panels' lobes) is traced once for every hour,
+//!    on the room with the panel dark to the sun; the panel's lobes' bounces
+//!    are read from lobe coefficients ([`LobeTable`]: traced once per
+//!    direction node the combinations' lobes fall among, not once per hour
+//!    and combination); a combination then traces only its lobes' direct
+//!    light at the sensors, hour by hour (sharp, and cheap), and reads the
+//!    year.
 
 use std::ops::Range;
 use std::sync::Arc;
 
-use crate::annual::{AnnualOptions, Occupancy, annual};
-use crate::light::{LightModel, SensorCoefficients};
-use crate::panel::{KeyKind, PanelCatalog, Parameters, base_dir};
+use glam::DVec3;
+
+use crate::annual::{AnnualOptions, MAX_TABLE_BYTES, Occupancy, YearSkies, annual, sun_direction};
+use crate::light::{LightModel, LobeTable, SensorCoefficients, SunPath, Sunlit};
+use crate::panel::{KeyKind, PanelCatalog, PanelModel, PanelResponse, Parameters, base_dir};
 use crate::scene::{Material, MaterialKind, Scene};
-use crate::sky::Sky;
+use crate::site::Site;
+use crate::sky::{Sky, SunSource};
+use crate::weather::HOURS;
 use crate::weather::Weather;
 
 /// The most keys varied together.
@@ -279,6 +291,10 @@ pub fn sweep(
 ) -> Vec<Outcome> {
     let coefficients = variation.is_panel().then(|| model.sensor_coefficients());
     let back_reflectance = model.panel_back_reflectance(variation.material);
+    let mut year = match (target, &coefficients) {
+        (Target::Year(weather, occupancy), Some(coefficients)) => SweptYear::new(model, coefficients, variation, weather, occupancy),
+        _ => None,
+    };
     let total = range.len().max(1);
     range
         .enumerate()
@@ -287,11 +303,13 @@ pub fn sweep(
             let result = variation.material(grid, &values).and_then(|material| match (&material.kind, &coefficients) {
                 (MaterialKind::Panel { model: panel, .. }, Some(coefficients)) => {
                     model.set_panel_model(variation.material, panel.0.clone());
-                    if model.panel_back_reflectance(variation.material) == back_reflectance {
-                        evaluate(model, coefficients, sensors, target)
-                    } else {
+                    if model.panel_back_reflectance(variation.material) != back_reflectance {
                         // The room's interreflection changed with the panel's back.
                         evaluate(model, &model.sensor_coefficients(), sensors, target)
+                    } else if let (Some(year), Target::Year(weather, occupancy)) = (&mut year, target) {
+                        year.evaluate(model, coefficients, weather, occupancy, sensors)
+                    } else {
+                        evaluate(model, coefficients, sensors, target)
                     }
                 }
                 _ => {
@@ -324,6 +342,92 @@ fn evaluate(
             let year = annual(model, &model.scene.site, weather, &options, &|_| {})?;
             Ok((sensors.iter().map(|&s| year.sensors[s].da300).collect(), Some(year.sda())))
         }
+    }
+}
+
+/// A year of sun prepared once for a sweep of a panel's keys ([`sweep`]'s
+/// step 4): every hour's sun but the panel's lobes, how the sun lights the
+/// panel's windows, and the lobe coefficients, which grow as
+/// combinations' lobes ask for nodes.
+struct SweptYear {
+    skies: YearSkies,
+    /// Per hour of the year whose sun the study reads: its direction, how
+    /// it lights the panel's windows, and the interreflected light (lux per
+    /// W/m²) of its every beam but the panel's lobes.
+    hours: Vec<Option<(DVec3, Sunlit, Vec<f32>)>>,
+    table: LobeTable,
+}
+
+/// The swept panel with its lobes taken away: the room with it dark to
+/// the sun is where the rest of the year's sun is traced.
+#[derive(Debug)]
+struct WithoutLobes(Arc<dyn PanelModel>);
+
+impl PanelModel for WithoutLobes {
+    fn response(&self, incoming: DVec3) -> PanelResponse {
+        let mut response = self.0.response(incoming);
+        response.lobes.retain(|lobe| lobe.direction.z <= 0.0);
+        response
+    }
+
+    fn back_reflectance(&self) -> f64 {
+        self.0.back_reflectance()
+    }
+}
+
+impl SweptYear {
+    /// The year's sun on `model` (its panel as the scene file has it) but
+    /// for `variation`'s lobes; `None` when the rest of the sun would take
+    /// more than [`MAX_TABLE_BYTES`] in memory (combinations then trace
+    /// their years whole).
+    fn new(
+        model: &mut LightModel,
+        coefficients: &SensorCoefficients,
+        variation: &Variation,
+        weather: &Weather,
+        occupancy: Occupancy,
+    ) -> Option<Self> {
+        let MaterialKind::Panel { model: panel, .. } = &variation.base.kind else { return None };
+        let site: Site = model.scene.site;
+        let with_sun = AnnualOptions { occupancy, ..Default::default() }.hours_with_sun(weather);
+        let suns: Vec<Option<DVec3>> = (0..HOURS).map(|k| with_sun[k].then(|| sun_direction(&site, k)).flatten()).collect();
+        let up: Vec<DVec3> = suns.iter().flatten().copied().collect();
+        if up.len() * model.scene.sensors.len() * size_of::<f32>() > MAX_TABLE_BYTES {
+            return None;
+        }
+        model.set_panel_model(variation.material, Arc::new(WithoutLobes(panel.0.clone())));
+        let path = SunPath::new(model, coefficients, &site, &up, None);
+        let table = LobeTable::new(model, variation.material);
+        let hours = crate::light::par_map(None, HOURS, |k| {
+            let sun = suns[k]?;
+            let rest = coefficients.sun_response(model, sun, &path, Some(1)).interreflected;
+            Some((sun, table.sunlit(model, sun), rest))
+        });
+        model.set_panel_model(variation.material, panel.0.clone());
+        Some(Self { skies: YearSkies::binned(&site, weather, model), hours, table })
+    }
+
+    /// The year of `model` (a combination's panel in the windows): DA300
+    /// at `sensors` and the scene's sDA.
+    fn evaluate(
+        &mut self,
+        model: &LightModel,
+        coefficients: &SensorCoefficients,
+        weather: &Weather,
+        occupancy: Occupancy,
+        sensors: &[usize],
+    ) -> Result<(Vec<f64>, Option<f64>), String> {
+        let lobes: Vec<_> = self.hours.iter().flatten().flat_map(|(sun, ..)| model.sun_beams(&SunSource::unit(*sun))).collect();
+        self.table.trace(model, coefficients, &lobes, None);
+        let (hours, table) = (&self.hours, &self.table);
+        let sun = |k: usize| {
+            let (direction, sunlit, rest) = hours[k].as_ref()?;
+            Some(coefficients.sun_response_with_lobes(model, *direction, table, sunlit, rest, Some(1)))
+        };
+        let options =
+            AnnualOptions { occupancy, coefficients: Some(coefficients), sun: Some(&sun), skies: Some(&self.skies), ..Default::default() };
+        let year = annual(model, &model.scene.site, weather, &options, &|_| {})?;
+        Ok((sensors.iter().map(|&s| year.sensors[s].da300).collect(), Some(year.sda())))
     }
 }
 

@@ -44,10 +44,11 @@
 mod sun_hours;
 
 use sun_hours::YearSun;
-pub use sun_hours::{MAX_TABLE_BYTES, SunHours};
+pub use sun_hours::{MAX_TABLE_BYTES, SunHours, sun_direction};
 
 use glam::DVec3;
 
+use crate::light::coefficients::SunResponse;
 use crate::light::{LightModel, SensorCoefficients, SunPath, par_map};
 use crate::site::Site;
 use crate::sky::{Sky, SkyError, SkySpec, perez, sky_at};
@@ -281,7 +282,49 @@ pub struct AnnualOptions<'a> {
     /// makes (the light cache folder), so the next year of the same scene
     /// and site reads them; `None`: made for this run only.
     pub sun_cache: Option<&'a std::path::Path>,
+    /// The year's sun given hour by hour instead of traced or read from
+    /// `sun_hours`, for the study's [`Self::hours_with_sun`]: a sweep of
+    /// panel keys reads its lobes' bounces from a [`crate::light::LobeTable`].
+    /// Not with shades studied.
+    pub sun: Option<HourlySun<'a>>,
+    /// The year's skies, when the caller has them ([`YearSkies::new`] of
+    /// the same site and weather, or [`YearSkies::binned`] on this model or
+    /// one that differs from it in panels alone); made by the run otherwise.
+    pub skies: Option<&'a YearSkies>,
 }
+
+/// Every hour's Perez sky of a year of weather at a site ([`hour_sky`]),
+/// and with [`Self::binned`] each lit sky's radiance over a model's sphere
+/// bins: what many studies of one year on one room share (a sweep's
+/// combinations).
+pub struct YearSkies {
+    skies: Vec<Result<Option<Sky>, SkyError>>,
+    /// Per hour, [`LightModel::sphere_bins`] of its sky, when kept.
+    bins: Vec<Option<Vec<f64>>>,
+}
+
+impl YearSkies {
+    /// The skies of `weather`'s hours at `site`.
+    pub fn new(site: &Site, weather: &Weather) -> Self {
+        let skies = par_map(None, HOURS, |k| {
+            let hour = &weather.hours[k];
+            hour_sky(site, &hour_time(hour.month, hour.day, hour.hour), hour.direct_normal, hour.diffuse_horizontal)
+        });
+        Self { skies, bins: Vec::new() }
+    }
+
+    /// The skies with their radiance over `model`'s sphere bins, for
+    /// studies on `model` and on models that differ from it in panels alone.
+    pub fn binned(site: &Site, weather: &Weather, model: &LightModel) -> Self {
+        let mut year = Self::new(site, weather);
+        year.bins = par_map(None, HOURS, |k| year.skies[k].as_ref().ok().and_then(Option::as_ref).map(|sky| model.sphere_bins(sky)));
+        year
+    }
+}
+
+/// Hour `k` of the year's sun at every sensor per W/m² of direct normal
+/// irradiance; `None` with the sun down.
+pub type HourlySun<'a> = &'a (dyn Fn(usize) -> Option<SunResponse> + Sync);
 
 impl AnnualOptions<'_> {
     /// The hours of `weather`'s year whose sun the study reads (one per
@@ -333,13 +376,15 @@ pub fn annual(
     // Tracing the year's sun, when it falls to us, is most of the work.
     let with_sun = options.hours_with_sun(weather);
     let own_table;
-    let year_sun = match options.sun_hours {
-        Some(table) if !table.fits(model, site, shades.is_some()) => {
+    let year_sun = match (options.sun_hours, options.sun) {
+        (_, Some(_)) if shades.is_some() => return Err("a year's sun given hour by hour cannot study shades".into()),
+        (_, Some(given)) => YearSun::Given(given),
+        (Some(table), _) if !table.fits(model, site, shades.is_some()) => {
             return Err("the year's sun was traced for another scene, site or shade study".into());
         }
-        Some(table) if !table.holds(&with_sun) => return Err("the year's sun was traced for other hours than this study reads".into()),
-        Some(table) => YearSun::Table(table),
-        None => match options.sun_cache.and_then(|dir| {
+        (Some(table), _) if !table.holds(&with_sun) => return Err("the year's sun was traced for other hours than this study reads".into()),
+        (Some(table), _) => YearSun::Table(table),
+        (None, None) => match options.sun_cache.and_then(|dir| {
             SunHours::cached(model, coefficients, site, shades.is_some(), &with_sun, dir, &|done| progress(SUN_TRACING_SHARE * done))
         }) {
             Some((table, _)) => {
@@ -350,10 +395,16 @@ pub fn annual(
         },
     };
     let tracing_share = if options.sun_hours.is_none() && matches!(year_sun, YearSun::Table(_)) { SUN_TRACING_SHARE } else { 0.0 };
-    let skies: Vec<Result<Option<Sky>, SkyError>> = par_map(None, HOURS, |k| {
-        let hour = &weather.hours[k];
-        hour_sky(site, &hour_time(hour.month, hour.day, hour.hour), hour.direct_normal, hour.diffuse_horizontal)
-    });
+    let own_skies;
+    let year_skies = match options.skies {
+        Some(skies) => skies,
+        None => {
+            own_skies = YearSkies::new(site, weather);
+            &own_skies
+        }
+    };
+    let skies = &year_skies.skies;
+    let bins = |k: usize| year_skies.bins.get(k).and_then(Option::as_deref);
     let lit = |k: usize| skies[k].as_ref().ok().and_then(Option::as_ref);
 
     // Which shade groups are down in each hour (a bit per group), and the
@@ -396,7 +447,7 @@ pub fn annual(
     let readings = |k: usize| -> Result<Option<Vec<(f64, f64)>>, String> {
         let Some(sky) = lit(k) else { return Ok(None) };
         let sun = if with_sun[k] { year_sun.response(k)? } else { None };
-        let open = coefficients.readings_with_sun(model, sky, sun.as_ref(), Some(1));
+        let open = coefficients.readings_with_sun(model, sky, bins(k), sun.as_ref(), Some(1));
         Ok(Some(match shaded.iter().find(|(mask, ..)| *mask == down[k]) {
             Some((_, shaded_model, coefficients, path)) => {
                 let lowered = coefficients.readings_on_path(shaded_model, sky, path, Some(1));

@@ -273,6 +273,8 @@ impl SunHours {
 /// hour where none is kept ([`SunHours::cached`]).
 pub(super) enum YearSun<'a> {
     Table(&'a SunHours),
+    /// Given by the caller ([`super::AnnualOptions::sun`]); no shades.
+    Given(super::HourlySun<'a>),
     Traced {
         model: &'a LightModel,
         coefficients: &'a SensorCoefficients,
@@ -306,6 +308,7 @@ impl<'a> YearSun<'a> {
     pub(super) fn response(&self, k: usize) -> Result<Option<SunResponse>, String> {
         match self {
             YearSun::Table(table) => table.response(k),
+            YearSun::Given(sun) => Ok(sun(k)),
             YearSun::Traced { model, coefficients, site, path, hours, .. } => {
                 Ok(traced_sun(site, hours, k)?.map(|sun| coefficients.sun_response(model, sun, path, Some(1))))
             }
@@ -317,6 +320,7 @@ impl<'a> YearSun<'a> {
     pub(super) fn through_shades(&self, k: usize) -> Result<Option<Vec<f32>>, String> {
         match self {
             YearSun::Table(table) => table.through_shades(k),
+            YearSun::Given(_) => Ok(Some(Vec::new())),
             YearSun::Traced { model, site, hours, shade_groups, .. } => {
                 Ok(traced_sun(site, hours, k)?.map(|sun| through_shades(model, sun, *shade_groups)))
             }
@@ -346,7 +350,7 @@ fn sun_directions(site: &Site, hours: &[bool]) -> Vec<Option<Option<DVec3>>> {
 
 /// The sun's direction in the model's frame at the middle of hour `k` of the
 /// 365-day year, as [`super::hour_sky`]'s sky places it; `None` when down.
-fn sun_direction(site: &Site, k: usize) -> Option<DVec3> {
+pub fn sun_direction(site: &Site, k: usize) -> Option<DVec3> {
     let (month, day, hour) = calendar(k);
     let sun = solar_position(site, &hour_time(month, day, hour));
     (sun.altitude > 0.0).then(|| direction_from_angles(sun.altitude, sun.azimuth + site.north_turn))

@@ -37,7 +37,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::cache::{self, CacheOutcome, Fnv, Reader, Writer};
-use super::daylight::RadianceSlots;
+use super::daylight::{KeyRadiance, RadianceSlots};
 use super::sun::Reach;
 use super::{LightModel, SensorReading, SunBeam, luminous, par_map};
 use crate::site::Site;
@@ -73,7 +73,7 @@ pub struct SensorCoefficients {
     seen: Vec<bool>,
     /// Sides some sensor's rays land on: where the sun's first bounce is
     /// traced, hour by hour.
-    hit: Vec<bool>,
+    pub(super) hit: Vec<bool>,
     /// Jacobi iterations of the slowest block.
     pub iterations: usize,
 }
@@ -300,7 +300,8 @@ impl SensorCoefficients {
         let beams = sky.sun_up().map(|s| model.sun_beams(&s)).unwrap_or_default();
         let measured = model.measured_sun(&beams);
         let direct = par_map(threads, model.sensors.len(), |i| model.sensor_direct_sun(i, &beams, &measured) * LUMINOUS_EFFICACY);
-        self.read(model, sky, SunLux { direct, interreflected: self.interreflected_sun(model, &beams, threads) }, threads)
+        let sun = SunLux { direct, interreflected: self.interreflected_sun(model, &beams, threads) };
+        self.read(model, model.key_radiance(sky), sun, threads)
     }
 
     /// [`Self::readings`] with the sun's light beyond its first bounce read
@@ -308,16 +309,18 @@ impl SensorCoefficients {
     /// bounce where the sensors' rays land are still traced.
     pub fn readings_on_path(&self, model: &LightModel, sky: &Sky, path: &SunPath, threads: Option<usize>) -> Vec<SensorReading> {
         let response = sky.sun_up().map(|s| self.sun_response(model, s.direction, path, threads));
-        self.readings_with_sun(model, sky, response.as_ref(), threads)
+        self.readings_with_sun(model, sky, None, response.as_ref(), threads)
     }
 
     /// The readings under `sky` with the sun's light from `response` (its
     /// sun's direction; `None` when the sun is down), scaled by the sky's
-    /// sun: no ray is traced.
+    /// sun: no ray is traced. `bins`: the sky's
+    /// [`LightModel::sphere_bins`], when the caller keeps them.
     pub fn readings_with_sun(
         &self,
         model: &LightModel,
         sky: &Sky,
+        bins: Option<&[f64]>,
         response: Option<&SunResponse>,
         threads: Option<usize>,
     ) -> Vec<SensorReading> {
@@ -328,7 +331,8 @@ impl SensorCoefficients {
             _ => vec![0.0; count],
         };
         let sun = SunLux { direct: scaled(response.map(|r| &r.direct)), interreflected: scaled(response.map(|r| &r.interreflected)) };
-        self.read(model, sky, sun, threads)
+        let seen = model.key_radiance_in(sky, bins.map_or_else(|| model.sphere_bins(sky), <[f64]>::to_vec));
+        self.read(model, seen, sun, threads)
     }
 
     /// The sun's light at every sensor for a sun of 1 W/m² normal
@@ -344,10 +348,10 @@ impl SensorCoefficients {
         SunResponse { direct, interreflected }
     }
 
-    /// The readings with the sun's light at every sensor given.
-    fn read(&self, model: &LightModel, sky: &Sky, sun: SunLux, threads: Option<usize>) -> Vec<SensorReading> {
+    /// The readings with what the gather keys see (`seen`) and the sun's
+    /// light at every sensor given.
+    fn read(&self, model: &LightModel, seen: KeyRadiance, sun: SunLux, threads: Option<usize>) -> Vec<SensorReading> {
         let count = model.sensors.len();
-        let seen = model.key_radiance(sky);
         let mut indirect = sun.interreflected;
         let slot_radiance = seen.slots();
         debug_assert_eq!(slot_radiance.len(), self.slots.len());
@@ -377,7 +381,7 @@ impl SensorCoefficients {
     }
 
     /// The beams' first bounce where each sensor's rays land, lux.
-    fn first_bounce(&self, model: &LightModel, beams: &[SunBeam], reach: &[Reach], threads: Option<usize>) -> Vec<f64> {
+    pub(super) fn first_bounce(&self, model: &LightModel, beams: &[SunBeam], reach: &[Reach], threads: Option<usize>) -> Vec<f64> {
         par_map(threads, model.sensors.len(), |i| luminous(model.sensor_sun_bounce(i, beams, reach)) * LUMINOUS_EFFICACY)
     }
 
@@ -391,7 +395,7 @@ impl SensorCoefficients {
     /// their accuracy while the nodes trace half the rays on the office
     /// (office hours against `sensors`: max 1.57% where all samples gave
     /// 1.66%).
-    fn path_sun_samples(&self, full: usize) -> Vec<usize> {
+    pub(super) fn path_sun_samples(&self, full: usize) -> Vec<usize> {
         let row = |side: usize| &self.sun[side * self.sensors..(side + 1) * self.sensors];
         let importance: Vec<f64> = (0..self.seen.len()).map(|side| row(side).iter().map(|&c| f64::from(c)).fold(0.0, f64::max)).collect();
         let enough = PATH_IMPORTANCE_SHARE * importance.iter().copied().fold(0.0, f64::max);
@@ -408,13 +412,13 @@ impl SensorCoefficients {
 
     /// The terms of the beams' later bounces: each side's beam irradiance
     /// with its row of coefficients.
-    fn later_bounces<'s>(&'s self, beams_on_sides: &'s [f64]) -> impl Iterator<Item = (&'s f64, &'s [f32])> {
+    pub(super) fn later_bounces<'s>(&'s self, beams_on_sides: &'s [f64]) -> impl Iterator<Item = (&'s f64, &'s [f32])> {
         beams_on_sides.iter().zip(self.sun.chunks_exact(self.sensors.max(1)))
     }
 }
 
 /// `sum` += Σ source × row, over (source, row of coefficients per sensor).
-fn add_products<'r>(sum: &mut [f64], terms: impl Iterator<Item = (&'r f64, &'r [f32])>) {
+pub(super) fn add_products<'r>(sum: &mut [f64], terms: impl Iterator<Item = (&'r f64, &'r [f32])>) {
     for (&source, row) in terms {
         if source != 0.0 {
             for (e, &c) in sum.iter_mut().zip(row) {

@@ -127,8 +127,19 @@ impl LightModel {
     /// The radiance behind each gather key under `sky`: a bin's own, or
     /// through a panel window what the panel makes of the sky and sun.
     pub(super) fn key_radiance(&self, sky: &Sky) -> KeyRadiance {
+        self.key_radiance_in(sky, self.sphere_bins(sky))
+    }
+
+    /// `sky`'s mean radiance in each sphere bin of the model's sky bins
+    /// (sky, then ground): integrated once for a sky read many times.
+    pub fn sphere_bins(&self, sky: &Sky) -> Vec<f64> {
         let mut bins = Vec::with_capacity(self.bin_count() as usize);
         self.sky_bins.integrate_sphere_into(sky, &mut bins);
+        bins
+    }
+
+    /// [`Self::key_radiance`] with `sky`'s [`Self::sphere_bins`] given.
+    pub(super) fn key_radiance_in(&self, sky: &Sky, bins: Vec<f64>) -> KeyRadiance {
         let sun = sky.sun_up();
         let panels = self.panel_groups.iter().map(|g| g.radiance_through(&self.sky_bins, &bins)).collect();
         // What shades a panel's windows from the sun shades what it diffuses.

@@ -303,6 +303,11 @@ pub struct SunBeam {
     pub normal_irradiance: f64,
     /// The panel group the beam comes out of; `None` for the sun itself.
     pub panel_group: Option<u32>,
+    /// For a lobe, the real sun's direction: how much of the lobe leaves
+    /// by a point of its windows is how much sun reaches that point from
+    /// outside. `None`: the windows taken as sunlit throughout (a unit lobe
+    /// of a [`super::LobeTable`]). Unused for the sun itself.
+    pub window_sun: Option<DVec3>,
 }
 
 /// How a panel's room side looks under a sky: the light it sends into the
@@ -463,7 +468,8 @@ pub fn spread(lobe: &Lobe) -> Vec<(DVec3, f64)> {
 /// beam carries the flux the panel's area receives (E · cos θin) times its
 /// share, spread over the beam's cross section (÷ cos θout).
 pub fn sun_beams(groups: &[PanelGroup], sun: &SunSource) -> Vec<SunBeam> {
-    let mut beams = vec![SunBeam { to_light: sun.direction, normal_irradiance: sun.normal_irradiance(), panel_group: None }];
+    let mut beams =
+        vec![SunBeam { to_light: sun.direction, normal_irradiance: sun.normal_irradiance(), panel_group: None, window_sun: None }];
     for (index, group) in groups.iter().enumerate() {
         let (irradiance, lobes) = group.transmitted_lobes(sun);
         for lobe in &lobes {
@@ -472,6 +478,7 @@ pub fn sun_beams(groups: &[PanelGroup], sun: &SunSource) -> Vec<SunBeam> {
                     to_light: -group.frame.to_world(direction).normalize(),
                     normal_irradiance: irradiance * share / direction.z,
                     panel_group: Some(index as u32),
+                    window_sun: Some(sun.direction),
                 });
             }
         }

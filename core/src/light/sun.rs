@@ -42,8 +42,8 @@ impl LightModel {
             Reach::None => 0.0,
             Reach::Open => self.beams_irradiance(point, normal, beams),
             Reach::Through(ways) => {
-                let (origin, sun) = (point + normal * SURFACE_OFFSET, beams[0].to_light);
-                self.openings.beams_reaching(point, ways).map(|b| self.beam_irradiance(origin, normal, &beams[b], sun)).sum()
+                let origin = point + normal * SURFACE_OFFSET;
+                self.openings.beams_reaching(point, ways).map(|b| self.beam_irradiance(origin, normal, &beams[b])).sum()
             }
         }
     }
@@ -98,10 +98,12 @@ impl LightModel {
 
     /// How much of a panel lobe's light reaches `point` from `to_light`:
     /// the ray must leave through a window of the lobe's panel group (glass
-    /// on the way counts), and from there the real sun must reach it.
-    fn lobe_transmittance(&self, point: DVec3, to_light: DVec3, group: u32, sun: DVec3) -> f64 {
-        self.reaches_panel(point, to_light, group)
-            .map_or(0.0, |(at, transmittance)| transmittance * self.sun_transmittance(at + sun * SURFACE_OFFSET, sun))
+    /// on the way counts), and from there the real sun (`window_sun`; `None`:
+    /// the windows taken as sunlit) must reach it.
+    fn lobe_transmittance(&self, point: DVec3, to_light: DVec3, group: u32, window_sun: Option<DVec3>) -> f64 {
+        self.reaches_panel(point, to_light, group).map_or(0.0, |(at, transmittance)| {
+            transmittance * window_sun.map_or(1.0, |sun| self.sun_transmittance(at + sun * SURFACE_OFFSET, sun))
+        })
     }
 
     /// The beams of direct sunlight for a sun: itself and its panel lobes.
@@ -208,21 +210,19 @@ impl LightModel {
     /// Direct sun irradiance (W/m²) from all `beams` at `point` on a surface
     /// side with `normal`.
     pub fn beams_irradiance(&self, point: DVec3, normal: DVec3, beams: &[SunBeam]) -> f64 {
-        let sun = beams.first().map_or(DVec3::Z, |b| b.to_light);
         let origin = point + normal * SURFACE_OFFSET;
-        beams.iter().map(|beam| self.beam_irradiance(origin, normal, beam, sun)).sum()
+        beams.iter().map(|beam| self.beam_irradiance(origin, normal, beam)).sum()
     }
 
-    /// One beam's irradiance at `origin` (already off its surface), with
-    /// `sun` the real sun's direction.
-    fn beam_irradiance(&self, origin: DVec3, normal: DVec3, beam: &SunBeam, sun: DVec3) -> f64 {
+    /// One beam's irradiance at `origin` (already off its surface).
+    fn beam_irradiance(&self, origin: DVec3, normal: DVec3, beam: &SunBeam) -> f64 {
         let cos = normal.dot(beam.to_light);
         if cos <= 0.0 {
             return 0.0;
         }
         let reach = match beam.panel_group {
             None => self.sun_transmittance(origin, beam.to_light),
-            Some(group) => self.lobe_transmittance(origin, beam.to_light, group, sun),
+            Some(group) => self.lobe_transmittance(origin, beam.to_light, group, beam.window_sun),
         };
         beam.normal_irradiance * cos * reach
     }
@@ -234,14 +234,13 @@ impl LightModel {
     /// [`Scene::windows`]: crate::scene::Scene::windows
     pub fn sensor_sun_by_window(&self, index: usize, beams: &[SunBeam], measured: &MeasuredSun) -> Vec<(Option<u32>, f64)> {
         let geometry = &self.sensors[index];
-        let sun = beams.first().map_or(DVec3::Z, |b| b.to_light);
         let mut by_window: Vec<(Option<u32>, f64)> =
             self.sensor_measured_sun(index, measured).into_iter().map(|(window, e)| (Some(window), e)).collect();
         let share = 1.0 / geometry.sun_points.len() as f64;
         for &point in &geometry.sun_points {
             let origin = point + geometry.normal * SURFACE_OFFSET;
             for beam in beams.iter().filter(|b| !measured.covers(b.panel_group)) {
-                let e = self.beam_irradiance(origin, geometry.normal, beam, sun);
+                let e = self.beam_irradiance(origin, geometry.normal, beam);
                 if e > 0.0 {
                     let hit = self.shadow_tracer.closest(origin, beam.to_light, 1e-6);
                     let window = hit.and_then(|h| self.window_of_surface[h.patch as usize]);
