@@ -25,12 +25,13 @@
 //!    anew.
 //! 4. **A year** ([`SweptYear`]): what does not pass the panel (the sun
 //!    through glass, other panels' lobes) is traced once for every hour,
-//!    on the room with the panel dark to the sun; the panel's lobes' bounces
-//!    are read from lobe coefficients ([`LobeTable`]: traced once per
-//!    direction node the combinations' lobes fall among, not once per hour
-//!    and combination); a combination then traces only its lobes' direct
-//!    light at the sensors, hour by hour (sharp, and cheap), and reads the
-//!    year.
+//!    on the room with the panel dark to the sun, and the sky light that
+//!    does not pass it is read once per hour ([`YearSkies::beside_panels`]);
+//!    the panel's lobes' bounces are read from lobe coefficients
+//!    ([`LobeTable`]: traced once per direction node the combinations'
+//!    lobes fall among, not once per hour and combination); a combination
+//!    then traces only its beams' direct light at the sensors, hour by hour
+//!    (sharp, and cheap), and reads what its panel passes.
 
 use std::ops::Range;
 use std::sync::Arc;
@@ -38,7 +39,7 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use crate::annual::{AnnualOptions, MAX_TABLE_BYTES, Occupancy, YearSkies, annual, sun_direction};
-use crate::light::{LightModel, LobeTable, SensorCoefficients, SunPath, Sunlit};
+use crate::light::{LightModel, LobeTable, SensorCoefficients, SunBeam, SunPath, Sunlit};
 use crate::panel::{KeyKind, PanelCatalog, PanelModel, PanelResponse, Parameters, base_dir};
 use crate::scene::{Material, MaterialKind, Scene};
 use crate::site::Site;
@@ -404,7 +405,8 @@ impl SweptYear {
             Some((sun, table.sunlit(model, sun), rest))
         });
         model.set_panel_model(variation.material, panel.0.clone());
-        Some(Self { skies: YearSkies::binned(&site, weather, model), hours, table })
+        let skies = YearSkies::binned(&site, weather, model).beside_panels(model, coefficients, table.groups());
+        Some(Self { skies, hours, table })
     }
 
     /// The year of `model` (a combination's panel in the windows): DA300
@@ -417,12 +419,13 @@ impl SweptYear {
         occupancy: Occupancy,
         sensors: &[usize],
     ) -> Result<(Vec<f64>, Option<f64>), String> {
-        let lobes: Vec<_> = self.hours.iter().flatten().flat_map(|(sun, ..)| model.sun_beams(&SunSource::unit(*sun))).collect();
-        self.table.trace(model, coefficients, &lobes, None);
+        let beams: Vec<Option<Vec<SunBeam>>> =
+            crate::light::par_map(None, HOURS, |k| self.hours[k].as_ref().map(|(sun, ..)| model.sun_beams(&SunSource::unit(*sun))));
+        self.table.trace(model, coefficients, beams.iter().flatten().flatten(), None);
         let (hours, table) = (&self.hours, &self.table);
         let sun = |k: usize| {
-            let (direction, sunlit, rest) = hours[k].as_ref()?;
-            Some(coefficients.sun_response_with_lobes(model, *direction, table, sunlit, rest, Some(1)))
+            let (_, sunlit, rest) = hours[k].as_ref()?;
+            Some(coefficients.sun_response_with_lobes(model, beams[k].as_deref()?, table, sunlit, rest, Some(1)))
         };
         let options =
             AnnualOptions { occupancy, coefficients: Some(coefficients), sun: Some(&sun), skies: Some(&self.skies), ..Default::default() };

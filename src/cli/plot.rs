@@ -32,6 +32,7 @@ pub fn write_sweep_picture(table: &Table, path: &Path) -> Result<(), String> {
     let metric =
         match (year, table.rows.iter().filter(|r| r.sensor != SDA_ROW).map(|r| &r.sensor).collect::<std::collections::BTreeSet<_>>().len())
         {
+            (true, 1) => format!("DA300 at {} ({})", table.rows[0].sensor, table.unit),
             (true, _) => format!("sDA300/50% ({})", table.unit),
             (false, 1) => format!("illuminance at {} ({})", table.rows[0].sensor, table.unit),
             (false, _) => format!("mean illuminance at the sensors ({})", table.unit),

@@ -49,7 +49,7 @@ pub use sun_hours::{MAX_TABLE_BYTES, SunHours, sun_direction};
 use glam::DVec3;
 
 use crate::light::coefficients::SunResponse;
-use crate::light::{LightModel, SensorCoefficients, SunPath, par_map};
+use crate::light::{KnownSky, LightModel, SensorCoefficients, SkyBesidePanels, SunPath, par_map};
 use crate::site::Site;
 use crate::sky::{Sky, SkyError, SkySpec, perez, sky_at};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
@@ -288,19 +288,22 @@ pub struct AnnualOptions<'a> {
     /// Not with shades studied.
     pub sun: Option<HourlySun<'a>>,
     /// The year's skies, when the caller has them ([`YearSkies::new`] of
-    /// the same site and weather, or [`YearSkies::binned`] on this model or
-    /// one that differs from it in panels alone); made by the run otherwise.
+    /// the same site and weather, or [`YearSkies::binned`] and
+    /// [`YearSkies::beside_panels`] on this model or one that differs from
+    /// it in those panels alone); made by the run otherwise.
     pub skies: Option<&'a YearSkies>,
 }
 
 /// Every hour's Perez sky of a year of weather at a site ([`hour_sky`]),
-/// and with [`Self::binned`] each lit sky's radiance over a model's sphere
-/// bins: what many studies of one year on one room share (a sweep's
-/// combinations).
+/// and, for studies of one room, what they read of each lit sky alike
+/// ([`Self::binned`], [`Self::beside_panels`]): what many studies of one
+/// year on one room share (a sweep's combinations).
 pub struct YearSkies {
     skies: Vec<Result<Option<Sky>, SkyError>>,
     /// Per hour, [`LightModel::sphere_bins`] of its sky, when kept.
     bins: Vec<Option<Vec<f64>>>,
+    /// Per hour, its sky light beside some panels, when kept.
+    beside: Vec<Option<SkyBesidePanels>>,
 }
 
 impl YearSkies {
@@ -310,15 +313,36 @@ impl YearSkies {
             let hour = &weather.hours[k];
             hour_sky(site, &hour_time(hour.month, hour.day, hour.hour), hour.direct_normal, hour.diffuse_horizontal)
         });
-        Self { skies, bins: Vec::new() }
+        Self { skies, bins: Vec::new(), beside: Vec::new() }
     }
 
     /// The skies with their radiance over `model`'s sphere bins, for
     /// studies on `model` and on models that differ from it in panels alone.
     pub fn binned(site: &Site, weather: &Weather, model: &LightModel) -> Self {
         let mut year = Self::new(site, weather);
-        year.bins = par_map(None, HOURS, |k| year.skies[k].as_ref().ok().and_then(Option::as_ref).map(|sky| model.sphere_bins(sky)));
+        year.bins = par_map(None, HOURS, |k| year.sky(k).map(|sky| model.sphere_bins(sky)));
         year
+    }
+
+    /// Keeps every lit hour's sky light beside the panels of `groups`
+    /// ([`SensorCoefficients::sky_beside_panels`]), for studies on models
+    /// that differ from `model` only in those panels: they read only what
+    /// the panels pass.
+    pub fn beside_panels(mut self, model: &LightModel, coefficients: &SensorCoefficients, groups: &[u32]) -> Self {
+        self.beside = par_map(None, HOURS, |k| {
+            let sky = self.sky(k)?;
+            Some(coefficients.sky_beside_panels(model, sky, self.bins.get(k).and_then(Option::as_deref), groups))
+        });
+        self
+    }
+
+    fn sky(&self, k: usize) -> Option<&Sky> {
+        self.skies[k].as_ref().ok().and_then(Option::as_ref)
+    }
+
+    /// What hour `k`'s readings take from here.
+    fn known(&self, k: usize) -> KnownSky<'_> {
+        KnownSky { bins: self.bins.get(k).and_then(Option::as_deref), beside_panels: self.beside.get(k).and_then(Option::as_ref) }
     }
 }
 
@@ -404,7 +428,6 @@ pub fn annual(
         }
     };
     let skies = &year_skies.skies;
-    let bins = |k: usize| year_skies.bins.get(k).and_then(Option::as_deref);
     let lit = |k: usize| skies[k].as_ref().ok().and_then(Option::as_ref);
 
     // Which shade groups are down in each hour (a bit per group), and the
@@ -447,7 +470,7 @@ pub fn annual(
     let readings = |k: usize| -> Result<Option<Vec<(f64, f64)>>, String> {
         let Some(sky) = lit(k) else { return Ok(None) };
         let sun = if with_sun[k] { year_sun.response(k)? } else { None };
-        let open = coefficients.readings_with_sun(model, sky, bins(k), sun.as_ref(), Some(1));
+        let open = coefficients.readings_with_sun(model, sky, year_skies.known(k), sun.as_ref(), Some(1));
         Ok(Some(match shaded.iter().find(|(mask, ..)| *mask == down[k]) {
             Some((_, shaded_model, coefficients, path)) => {
                 let lowered = coefficients.readings_on_path(shaded_model, sky, path, Some(1));

@@ -44,6 +44,13 @@ impl KeyRadiance {
         PI * gather.daylight_coefficients.iter().map(|&(k, w)| f64::from(w) * self.of(k)).sum::<f64>()
     }
 
+    /// [`Self::sky_irradiance`] of the keys whose panel group (`None`:
+    /// straight or through glass) `through` takes.
+    pub(super) fn sky_irradiance_through(&self, gather: &Gather, through: impl Fn(Option<u32>) -> bool) -> f64 {
+        let group = |k: u32| SkyKey::unpack(k, self.bin_count).window.and_then(|w| self.window_panel[w as usize]);
+        PI * gather.daylight_coefficients.iter().filter(|&&(k, _)| through(group(k))).map(|&(k, w)| f64::from(w) * self.of(k)).sum::<f64>()
+    }
+
     /// Sunlight that panels transmit diffusely (W/m²), seen through them.
     pub(super) fn panel_sun_irradiance(&self, gather: &Gather) -> f64 {
         PI * gather.daylight_coefficients.iter().map(|&(k, w)| f64::from(w) * self.sun_of(k)).sum::<f64>()
@@ -78,6 +85,17 @@ pub(super) struct RadianceSlots {
 impl RadianceSlots {
     pub(super) fn len(&self) -> usize {
         self.bin_count as usize * (1 + self.groups) + self.groups
+    }
+
+    /// The panel group whose light a slot carries (`None`: a bin seen
+    /// straight or through glass).
+    pub(super) fn group(&self, slot: usize) -> Option<u32> {
+        let bins = self.bin_count as usize;
+        match slot {
+            s if s < bins => None,
+            s if s < bins * (1 + self.groups) => Some((s / bins - 1) as u32),
+            s => Some((s - bins * (1 + self.groups)) as u32),
+        }
     }
 
     /// The slot of a key's sky radiance, and of its diffuse panel sun if it

@@ -29,7 +29,7 @@ use glam::DVec3;
 
 use super::coefficients::{SunResponse, add_products};
 use super::{LightModel, SURFACE_OFFSET, SensorCoefficients, SunBeam, par_map};
-use crate::sky::{LUMINOUS_EFFICACY, SunSource};
+use crate::sky::LUMINOUS_EFFICACY;
 
 /// The grid's step in both tilt angles, degrees.
 pub const LOBE_STEP: f64 = 2.0;
@@ -203,8 +203,9 @@ fn node_beam(model: &LightModel, (group, a, b): Node) -> (SunBeam, f64) {
 }
 
 impl SensorCoefficients {
-    /// The sun's light at every sensor for a sun of 1 W/m² from `direction`
-    /// (as [`Self::sun_response`]), with the interreflected light of
+    /// The sun's light at every sensor for a sun of 1 W/m² (as
+    /// [`Self::sun_response`]; `beams`: its [`LightModel::sun_beams`]),
+    /// with the interreflected light of
     /// `table`'s lobes read from it (traced first where it lacks nodes:
     /// [`LobeTable::trace`]) and that of every other beam given (`rest`,
     /// lux per W/m²: the sun through glass, other panels' lobes).
@@ -213,15 +214,14 @@ impl SensorCoefficients {
     pub fn sun_response_with_lobes(
         &self,
         model: &LightModel,
-        direction: DVec3,
+        beams: &[SunBeam],
         table: &LobeTable,
         sunlit: &Sunlit,
         rest: &[f32],
         threads: Option<usize>,
     ) -> SunResponse {
-        let beams = model.sun_beams(&SunSource::unit(direction));
-        let measured = model.measured_sun(&beams);
-        let direct = par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, &beams, &measured) * LUMINOUS_EFFICACY) as f32);
+        let measured = model.measured_sun(beams);
+        let direct = par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, beams, &measured) * LUMINOUS_EFFICACY) as f32);
         let mut first = vec![0.0; model.sensors.len()];
         let mut later = vec![0.0; model.sensors.len()];
         for (&group, &(share, even)) in table.groups.iter().zip(&sunlit.0) {

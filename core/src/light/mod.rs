@@ -49,7 +49,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-pub use coefficients::{SensorCoefficients, SunPath};
+pub use coefficients::{KnownSky, SensorCoefficients, SkyBesidePanels, SunPath};
 pub use gather::{Gather, SkyKey, sensor_points, side_of};
 pub use glass::Glass;
 pub use lobe_table::{LOBE_STEP, LobeTable, Sunlit};
