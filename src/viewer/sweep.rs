@@ -115,7 +115,8 @@ fn start_sweep(
     let weather = annual.weather.as_ref().map(|(_, w)| w.clone());
     let (sensor, sky) = (selected.0, sun_sky.map(|s| s.sky.clone()));
     let what = match (&weather, sensor) {
-        (Some(_), _) => "sDA300/50% over the year (%)".to_string(),
+        (Some(_), Some(s)) => format!("DA300 at {} over the year (%)", scene.sensors[s].name),
+        (Some(_), None) => "sDA300/50% over the year (%)".to_string(),
         (None, Some(s)) => format!("{} now (lux)", scene.sensors[s].name),
         (None, None) => {
             study.error = Some("select a sensor (or open a weather file for the year's sDA)".into());
@@ -141,7 +142,8 @@ fn start_sweep(
             let value = outcome
                 .result
                 .as_ref()
-                .map(|(values, sda)| sda.unwrap_or_else(|| values.first().copied().unwrap_or(0.0)))
+                // The selected sensor's value (lux now, or its DA300), else the year's sDA.
+                .map(|(values, sda)| values.first().copied().or(*sda).unwrap_or(0.0))
                 .map_err(Clone::clone);
             // Combinations come in grid order: each fills the first empty cell.
             let mut cells = cells.lock().expect("the sweep's cells");

@@ -94,7 +94,7 @@ impl SweepPanel<'_> {
         if study.is_running() {
             let (done, all) = study.progress();
             ui.add(egui::ProgressBar::new(done as f32 / all.max(1) as f32).text(format!("{done} of {all} combinations")));
-        } else if ui.button("Run the sweep (the selected sensor now, or sDA with a weather file)").clicked() {
+        } else if ui.button("Run the sweep (the selected sensor: now, or its DA300 with a weather file; no sensor: the sDA)").clicked() {
             study.requested = true;
         }
         if let Some(e) = &study.error {
