@@ -796,6 +796,35 @@ fn sweeps_against_a_year_read_what_annual_reads() {
     assert!(swept.iter().any(|s| s.0 == "sDA300/50%") && swept.len() > 5, "{out}");
 }
 
+/// A sweep over a year reads the windows as modelled: with `[[shades]]` in
+/// the scene it says so in one warning line (as `annual --no-shades`) and
+/// still answers.
+#[test]
+fn a_year_sweep_says_it_leaves_the_shades_up() {
+    let (_, epw) = folder_with_a_year("sweep_shades");
+    let scene = prismatic_room_with("sweep_shades", [40.0, 5.0]);
+    let text = std::fs::read_to_string(&scene).unwrap() + "\n[[shades]]\nwindows = \"glass\"\nshade = \"upper\"\n";
+    std::fs::write(&scene, text).unwrap();
+    let Run { code, err, .. } = heliodon(
+        &[
+            "sweep",
+            scene.to_str().unwrap(),
+            "--material",
+            "upper",
+            "--vary",
+            "facet_angles[0]=40..40:5",
+            "--sensor",
+            "back",
+            "--weather",
+            epw.to_str().unwrap(),
+        ],
+        &scratch(),
+    );
+    assert_eq!(code, 0, "{err}");
+    let warnings: Vec<&str> = err.lines().filter(|l| l.contains("[[shades]]")).collect();
+    assert!(warnings.len() == 1 && warnings[0].starts_with("warning: ") && warnings[0].contains("--no-shades"), "{err}");
+}
+
 #[test]
 fn sweeps_refuse_bad_input_in_one_line() {
     let room = bundled_scene("prismatic_room");

@@ -123,6 +123,9 @@ pub fn run(args: &SweepArgs, panels: &PanelCatalog) -> Result<(), CliError> {
         Some(path) => Some(Weather::read(path)?),
         None => None,
     };
+    if weather.is_some() && !scene.shades.is_empty() {
+        eprintln!("warning: {}: the sweep reads the year with the [[shades]] up, as `annual --no-shades` does", args.scene.display());
+    }
     let sky = match (args.date, args.time) {
         (Some(date), Some(time)) => Some(sky_for(&scene, &args.sky.spec()?, &args.sky.sky, LocalDateTime { date, time })?.1),
         _ => None,
