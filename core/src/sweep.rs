@@ -292,10 +292,18 @@ pub fn sweep(
 ) -> Vec<Outcome> {
     let coefficients = variation.is_panel().then(|| model.sensor_coefficients());
     let back_reflectance = model.panel_back_reflectance(variation.material);
-    let mut year = match (target, &coefficients) {
-        (Target::Year(weather, occupancy), Some(coefficients)) => SweptYear::new(model, coefficients, variation, weather, occupancy),
+    // The year's skies and their sphere bins, made once: every combination's model has the same sky bins.
+    let skies = match target {
+        Target::Year(weather, _) => Some(YearSkies::binned(&{ model.scene.site }, weather, model)),
+        Target::Instant(_) => None,
+    };
+    let mut year = match (target, &coefficients, &skies) {
+        (Target::Year(weather, occupancy), Some(coefficients), Some(skies)) => {
+            SweptYear::new(model, coefficients, variation, weather, occupancy, skies)
+        }
         _ => None,
     };
+    let skies = skies.as_ref();
     let total = range.len().max(1);
     range
         .enumerate()
@@ -306,18 +314,18 @@ pub fn sweep(
                     model.set_panel_model(variation.material, panel.0.clone());
                     if model.panel_back_reflectance(variation.material) != back_reflectance {
                         // The room's interreflection changed with the panel's back.
-                        evaluate(model, &model.sensor_coefficients(), sensors, target)
+                        evaluate(model, &model.sensor_coefficients(), sensors, target, skies)
                     } else if let (Some(year), Target::Year(weather, occupancy)) = (&mut year, target) {
                         year.evaluate(model, coefficients, weather, occupancy, sensors)
                     } else {
-                        evaluate(model, coefficients, sensors, target)
+                        evaluate(model, coefficients, sensors, target, skies)
                     }
                 }
                 _ => {
                     let mut scene = (*model.scene).clone();
                     scene.materials[variation.material as usize] = material;
                     let varied = LightModel::precompute(Arc::new(scene), model.settings)?;
-                    evaluate(&varied, &varied.sensor_coefficients(), sensors, target)
+                    evaluate(&varied, &varied.sensor_coefficients(), sensors, target, skies)
                 }
             });
             let outcome = Outcome { values, result };
@@ -327,11 +335,14 @@ pub fn sweep(
         .collect()
 }
 
+/// One combination's values, from scratch but for the coefficients given
+/// and the year's `skies` (made once per sweep).
 fn evaluate(
     model: &LightModel,
     coefficients: &SensorCoefficients,
     sensors: &[usize],
     target: Target,
+    skies: Option<&YearSkies>,
 ) -> Result<(Vec<f64>, Option<f64>), String> {
     match target {
         Target::Instant(sky) => {
@@ -339,7 +350,7 @@ fn evaluate(
             Ok((sensors.iter().map(|&s| readings[s].total).collect(), None))
         }
         Target::Year(weather, occupancy) => {
-            let options = AnnualOptions { occupancy, coefficients: Some(coefficients), ..Default::default() };
+            let options = AnnualOptions { occupancy, coefficients: Some(coefficients), skies, ..Default::default() };
             let year = annual(model, &model.scene.site, weather, &options, &|_| {})?;
             Ok((sensors.iter().map(|&s| year.sensors[s].da300).collect(), Some(year.sda())))
         }
@@ -387,6 +398,7 @@ impl SweptYear {
         variation: &Variation,
         weather: &Weather,
         occupancy: Occupancy,
+        skies: &YearSkies,
     ) -> Option<Self> {
         let MaterialKind::Panel { model: panel, .. } = &variation.base.kind else { return None };
         let site: Site = model.scene.site;
@@ -405,7 +417,7 @@ impl SweptYear {
             Some((sun, table.sunlit(model, sun), rest))
         });
         model.set_panel_model(variation.material, panel.0.clone());
-        let skies = YearSkies::binned(&site, weather, model).beside_panels(model, coefficients, table.groups());
+        let skies = skies.clone().beside_panels(model, coefficients, table.groups());
         Some(Self { skies, hours, table })
     }
 

@@ -298,6 +298,7 @@ pub struct AnnualOptions<'a> {
 /// and, for studies of one room, what they read of each lit sky alike
 /// ([`Self::binned`], [`Self::beside_panels`]): what many studies of one
 /// year on one room share (a sweep's combinations).
+#[derive(Clone)]
 pub struct YearSkies {
     skies: Vec<Result<Option<Sky>, SkyError>>,
     /// Per hour, [`LightModel::sphere_bins`] of its sky, when kept.
