@@ -1021,12 +1021,14 @@ impl heliodon_core::panel::PanelModel for DarkModel {
 /// Lobe coefficients (a panel's lobes' bounces traced once per node of a
 /// 2° grid of their directions and read between nodes) read what tracing
 /// reads, over a year of clear hours in the side room with its upper panes
-/// a redirecting panel and its lower ones glass: the direct light is traced
-/// by both (equal); the totals, with the glass's sun traced on the room
-/// with the panel dark, agree within the sun path's bounds
-/// (`the_sun_path_reads_what_tracing_reads`; measured: median 0.09%, 95th
-/// percentile 0.51%, max 2.0%). The sky light beside the panel, kept,
-/// reads as the whole sky read again.
+/// a redirecting panel, its lower ones glass, and an overhang whose shadow
+/// lies across the panes in most hours (their lobes' first bounce is then
+/// traced): the direct light is traced by both (equal); the totals, with
+/// the glass's sun traced on the room with the panel dark, agree within the
+/// sun path's bounds (`the_sun_path_reads_what_tracing_reads`; measured:
+/// median 0.09%, 95th percentile 0.62%, max 1.5%; read from the table as
+/// if the panes were evenly lit, the max is 5.2%). The sky light beside the
+/// panel, kept, reads as the whole sky read again.
 #[test]
 fn lobe_coefficients_read_what_tracing_reads() {
     use heliodon_core::annual::{hour_time, sun_direction};
@@ -1041,6 +1043,10 @@ fn lobe_coefficients_read_what_tracing_reads() {
         assert!(obj.contains(upper));
         obj = obj.replace(upper, &format!("usemtl upper\n{upper}usemtl glass\n"));
     }
+    // An overhang over the south windows: its shadow lies across the panes in much of the year.
+    let vertices = obj.lines().filter(|l| l.starts_with("v ")).count();
+    obj += "v 0 0 2.75\nv 4 0 2.75\nv 4 -0.6 2.75\nv 0 -0.6 2.75\ng overhang\nusemtl wall\n";
+    obj += &format!("f {} {} {} {}\n", vertices + 1, vertices + 2, vertices + 3, vertices + 4);
     std::fs::write(dir.join("model.obj"), obj).unwrap();
     let file = std::fs::read_to_string(sideroom()).unwrap() + "\n[materials.upper]\nkind = \"panel\"\npanel = \"redirecting\"\n";
     std::fs::write(dir.join("scene.toml"), file).unwrap();
@@ -1071,11 +1077,13 @@ fn lobe_coefficients_read_what_tracing_reads() {
     let beams: Vec<_> =
         skies.iter().flat_map(|sky| model.sun_beams(&heliodon_core::sky::SunSource::unit(sky.sun.unwrap().direction))).collect();
     table.trace(&model, &coefficients, &beams, None);
-    let mut errors = Vec::new();
+    let (mut errors, mut in_part_shade) = (Vec::new(), 0);
     for ((sky, &sun), rest) in skies.iter().zip(&suns).zip(&rests) {
+        let sunlit = table.sunlit(&model, sun);
+        in_part_shade += usize::from(!sunlit.is_even());
         let traced = coefficients.readings(&model, sky, None);
         let beams = model.sun_beams(&heliodon_core::sky::SunSource::unit(sun));
-        let response = coefficients.sun_response_with_lobes(&model, &beams, &table, &table.sunlit(&model, sun), rest, None);
+        let response = coefficients.sun_response_with_lobes(&model, &beams, &table, &sunlit, rest, None);
         let read = coefficients.readings_with_sun(&model, sky, Default::default(), Some(&response), None);
         for (a, b) in traced.iter().zip(&read) {
             assert!((a.direct_sun - b.direct_sun).abs() <= 1e-6 * a.direct_sun.max(1.0), "{} against {}", b.direct_sun, a.direct_sun);
@@ -1090,7 +1098,12 @@ fn lobe_coefficients_read_what_tracing_reads() {
     }
     errors.sort_by(f64::total_cmp);
     let (median, p95, max) = (errors[errors.len() / 2], errors[errors.len() * 95 / 100], errors[errors.len() - 1]);
-    println!("{} hours, {} nodes: median {median}, 95th percentile {p95}, max {max}", skies.len(), table.len());
+    println!(
+        "{} hours ({in_part_shade} with the panel in part shade), {} nodes: median {median}, 95th percentile {p95}, max {max}",
+        skies.len(),
+        table.len()
+    );
+    assert!(in_part_shade > 50, "{in_part_shade} hours with the overhang's shadow across the panel");
     assert!(median < 0.005 && p95 < 0.02 && max < 0.05, "median {median}, 95th percentile {p95}, max {max}");
     let _ = std::fs::remove_dir_all(&dir);
 }

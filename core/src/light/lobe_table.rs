@@ -47,6 +47,13 @@ type Node = (u32, i32, i32);
 /// whether that share is the same all over them.
 pub struct Sunlit(Vec<(f64, bool)>);
 
+impl Sunlit {
+    /// Whether the sun lights every group's windows alike all over.
+    pub fn is_even(&self) -> bool {
+        self.0.iter().all(|&(_, even)| even)
+    }
+}
+
 /// One node's interreflected light at every sensor per W/m² the lobe
 /// brings to the panel's plane (its normal irradiance times the cosine to
 /// the panel's normal: so near the plane, where that cosine changes fast
