@@ -18,10 +18,11 @@
 //! ([`super::SunPath`]) plus a first bounce.
 //!
 //! What is sharp is not read from the table: the lobes' direct light at
-//! the sensors is traced every hour ([`SensorCoefficients::sun_response_with_lobes`]),
-//! and so is their first bounce in an hour whose sun lights the group's
-//! windows only in part (a reveal's or an overhang's shadow on them); the
-//! later bounces are then read from the table, scaled by the sunlit share.
+//! the sensors is traced every hour ([`SensorCoefficients::sun_response_with_lobes`];
+//! on from the windows to the sun only where it lights them unevenly), and
+//! so is their first bounce in an hour whose sun lights the group's windows
+//! only in part (a reveal's or an overhang's shadow on them); the later
+//! bounces are then read from the table, scaled by the sunlit share.
 
 use std::collections::HashMap;
 
@@ -228,7 +229,25 @@ impl SensorCoefficients {
         threads: Option<usize>,
     ) -> SunResponse {
         let measured = model.measured_sun(beams);
-        let direct = par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, beams, &measured) * LUMINOUS_EFFICACY) as f32);
+        // Where the sun lights a group's windows evenly, its lobes leave every
+        // point of them alike: no shadow ray from the windows to the sun.
+        let evenly = |beam: &SunBeam| {
+            let group = table.groups.iter().position(|&g| Some(g) == beam.panel_group)?;
+            let (share, even) = sunlit.0[group];
+            even.then_some(share)
+        };
+        let direct_beams: Vec<SunBeam> = beams
+            .iter()
+            .filter_map(|beam| match evenly(beam) {
+                None => Some(*beam),
+                Some(share) if share > 0.0 => {
+                    Some(SunBeam { normal_irradiance: beam.normal_irradiance * share, window_sun: None, ..*beam })
+                }
+                Some(_) => None,
+            })
+            .collect();
+        let direct =
+            par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, &direct_beams, &measured) * LUMINOUS_EFFICACY) as f32);
         let mut first = vec![0.0; model.sensors.len()];
         let mut later = vec![0.0; model.sensors.len()];
         for (&group, &(share, even)) in table.groups.iter().zip(&sunlit.0) {
