@@ -46,6 +46,8 @@ mod sun_hours;
 use sun_hours::YearSun;
 pub use sun_hours::{MAX_TABLE_BYTES, SunHours, sun_direction};
 
+use std::sync::Arc;
+
 use glam::DVec3;
 
 use crate::light::coefficients::SunResponse;
@@ -298,11 +300,12 @@ pub struct AnnualOptions<'a> {
 /// and, for studies of one room, what they read of each lit sky alike
 /// ([`Self::binned`], [`Self::beside_panels`]): what many studies of one
 /// year on one room share (a sweep's combinations).
+/// A clone shares the skies and bins (a year of MF:4 bins is about 160 MB).
 #[derive(Clone)]
 pub struct YearSkies {
-    skies: Vec<Result<Option<Sky>, SkyError>>,
+    skies: Arc<Vec<Result<Option<Sky>, SkyError>>>,
     /// Per hour, [`LightModel::sphere_bins`] of its sky, when kept.
-    bins: Vec<Option<Vec<f64>>>,
+    bins: Arc<Vec<Option<Vec<f64>>>>,
     /// Per hour, its sky light beside some panels, when kept.
     beside: Vec<Option<SkyBesidePanels>>,
 }
@@ -314,14 +317,14 @@ impl YearSkies {
             let hour = &weather.hours[k];
             hour_sky(site, &hour_time(hour.month, hour.day, hour.hour), hour.direct_normal, hour.diffuse_horizontal)
         });
-        Self { skies, bins: Vec::new(), beside: Vec::new() }
+        Self { skies: Arc::new(skies), bins: Arc::default(), beside: Vec::new() }
     }
 
     /// The skies with their radiance over `model`'s sphere bins, for
     /// studies on `model` and on models that differ from it in panels alone.
     pub fn binned(site: &Site, weather: &Weather, model: &LightModel) -> Self {
         let mut year = Self::new(site, weather);
-        year.bins = par_map(None, HOURS, |k| year.sky(k).map(|sky| model.sphere_bins(sky)));
+        year.bins = Arc::new(par_map(None, HOURS, |k| year.sky(k).map(|sky| model.sphere_bins(sky))));
         year
     }
 
