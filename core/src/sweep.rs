@@ -38,7 +38,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use crate::annual::{AnnualOptions, MAX_TABLE_BYTES, Occupancy, YearSkies, annual, sun_direction};
+use crate::annual::{AnnualOptions, AnnualResult, MAX_TABLE_BYTES, Occupancy, YearSkies, annual, sun_directions};
 use crate::light::{LightModel, LobeTable, SensorCoefficients, SunBeam, SunPath, Sunlit};
 use crate::panel::{KeyKind, PanelCatalog, PanelModel, PanelResponse, Parameters, base_dir};
 use crate::scene::{Material, MaterialKind, Scene};
@@ -351,10 +351,14 @@ fn evaluate(
         }
         Target::Year(weather, occupancy) => {
             let options = AnnualOptions { occupancy, coefficients: Some(coefficients), skies, ..Default::default() };
-            let year = annual(model, &model.scene.site, weather, &options, &|_| {})?;
-            Ok((sensors.iter().map(|&s| year.sensors[s].da300).collect(), Some(year.sda())))
+            Ok(year_values(&annual(model, &model.scene.site, weather, &options, &|_| {})?, sensors))
         }
     }
+}
+
+/// A year's values for a sweep: DA300 at `sensors`, and the scene's sDA.
+fn year_values(year: &AnnualResult, sensors: &[usize]) -> (Vec<f64>, Option<f64>) {
+    (sensors.iter().map(|&s| year.sensors[s].da300).collect(), Some(year.sda()))
 }
 
 /// A year of sun prepared once for a sweep of a panel's keys ([`sweep`]'s
@@ -403,7 +407,7 @@ impl SweptYear {
         let MaterialKind::Panel { model: panel, .. } = &variation.base.kind else { return None };
         let site: Site = model.scene.site;
         let with_sun = AnnualOptions { occupancy, ..Default::default() }.hours_with_sun(weather);
-        let suns: Vec<Option<DVec3>> = (0..HOURS).map(|k| with_sun[k].then(|| sun_direction(&site, k)).flatten()).collect();
+        let suns: Vec<Option<DVec3>> = sun_directions(&site, &with_sun).into_iter().map(Option::flatten).collect();
         let up: Vec<DVec3> = suns.iter().flatten().copied().collect();
         if up.len() * model.scene.sensors.len() * size_of::<f32>() > MAX_TABLE_BYTES {
             return None;
@@ -441,8 +445,7 @@ impl SweptYear {
         };
         let options =
             AnnualOptions { occupancy, coefficients: Some(coefficients), sun: Some(&sun), skies: Some(&self.skies), ..Default::default() };
-        let year = annual(model, &model.scene.site, weather, &options, &|_| {})?;
-        Ok((sensors.iter().map(|&s| year.sensors[s].da300).collect(), Some(year.sda())))
+        Ok(year_values(&annual(model, &model.scene.site, weather, &options, &|_| {})?, sensors))
     }
 }
 

@@ -44,7 +44,7 @@
 mod sun_hours;
 
 use sun_hours::YearSun;
-pub use sun_hours::{MAX_TABLE_BYTES, SunHours, sun_direction};
+pub use sun_hours::{MAX_TABLE_BYTES, SunHours, sun_direction, sun_directions};
 
 use std::sync::Arc;
 

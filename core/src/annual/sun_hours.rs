@@ -344,7 +344,7 @@ fn not_traced(k: usize) -> String {
 /// The sun's direction at the middle of every hour of the year among
 /// `hours` ([`sun_direction`]; `Some(None)` with the sun down), `None` for
 /// the others.
-fn sun_directions(site: &Site, hours: &[bool]) -> Vec<Option<Option<DVec3>>> {
+pub fn sun_directions(site: &Site, hours: &[bool]) -> Vec<Option<Option<DVec3>>> {
     par_map(None, HOURS, |k| hours[k].then(|| sun_direction(site, k)))
 }
 

@@ -351,7 +351,7 @@ impl SensorCoefficients {
             _ => vec![0.0; count],
         };
         let sun = SunLux { direct: scaled(response.map(|r| &r.direct)), interreflected: scaled(response.map(|r| &r.interreflected)) };
-        let seen = model.key_radiance_in(sky, known.bins.map_or_else(|| model.sphere_bins(sky), <[f64]>::to_vec));
+        let seen = model.key_radiance_in(sky, known.bins);
         self.read(model, seen, sun, known.beside_panels, threads)
     }
 
@@ -360,7 +360,7 @@ impl SensorCoefficients {
     /// read once for a sky that models differing only in those panels read
     /// again ([`KnownSky::beside_panels`]).
     pub fn sky_beside_panels(&self, model: &LightModel, sky: &Sky, bins: Option<&[f64]>, groups: &[u32]) -> SkyBesidePanels {
-        let seen = model.key_radiance_in(sky, bins.map_or_else(|| model.sphere_bins(sky), <[f64]>::to_vec));
+        let seen = model.key_radiance_in(sky, bins);
         let beside = |group: Option<u32>| group.is_none_or(|g| !groups.contains(&g));
         let mut interreflected = vec![0.0; self.sensors];
         let radiance = seen.slots();

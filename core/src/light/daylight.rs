@@ -145,7 +145,7 @@ impl LightModel {
     /// The radiance behind each gather key under `sky`: a bin's own, or
     /// through a panel window what the panel makes of the sky and sun.
     pub(super) fn key_radiance(&self, sky: &Sky) -> KeyRadiance {
-        self.key_radiance_in(sky, self.sphere_bins(sky))
+        self.key_radiance_in(sky, None)
     }
 
     /// `sky`'s mean radiance in each sphere bin of the model's sky bins
@@ -156,8 +156,10 @@ impl LightModel {
         bins
     }
 
-    /// [`Self::key_radiance`] with `sky`'s [`Self::sphere_bins`] given.
-    pub(super) fn key_radiance_in(&self, sky: &Sky, bins: Vec<f64>) -> KeyRadiance {
+    /// [`Self::key_radiance`] with `sky`'s [`Self::sphere_bins`] given,
+    /// when the caller keeps them.
+    pub(super) fn key_radiance_in(&self, sky: &Sky, bins: Option<&[f64]>) -> KeyRadiance {
+        let bins = bins.map_or_else(|| self.sphere_bins(sky), <[f64]>::to_vec);
         let sun = sky.sun_up();
         let panels = self.panel_groups.iter().map(|g| g.radiance_through(&self.sky_bins, &bins)).collect();
         // What shades a panel's windows from the sun shades what it diffuses.

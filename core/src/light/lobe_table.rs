@@ -115,7 +115,7 @@ impl LobeTable {
         let missing: std::collections::BTreeSet<Node> = beams
             .into_iter()
             .filter(|b| self.holds(b))
-            .flat_map(|b| corners(model, b).0)
+            .flat_map(|b| corners(b, way_out(model, b)).0)
             .filter(|node| !self.nodes.contains_key(node))
             .collect();
         let missing: Vec<Node> = missing.into_iter().collect();
@@ -156,8 +156,10 @@ impl LobeTable {
     /// times `scale` (its normal irradiance, or a share of it): the first
     /// bounce to `first` (unless `None`), the later bounces to `later`.
     fn add(&self, model: &LightModel, beam: &SunBeam, scale: f64, first: Option<&mut [f64]>, later: &mut [f64]) {
-        let (nodes, weights) = corners(model, beam);
-        let scale = scale * panel_cos(model, beam);
+        let out = way_out(model, beam);
+        let (nodes, weights) = corners(beam, out);
+        // Per W/m² on the panel's plane (`NodeLight`).
+        let scale = scale * out.z;
         let mut first = first;
         for (node, weight) in nodes.iter().zip(weights) {
             let light = self.nodes.get(node).expect("traced before it is read");
@@ -175,15 +177,10 @@ fn way_out(model: &LightModel, beam: &SunBeam) -> DVec3 {
     model.panel_groups[beam.panel_group.expect("a lobe") as usize].frame.to_panel(-beam.to_light)
 }
 
-/// The cosine of a lobe to its panel's normal.
-fn panel_cos(model: &LightModel, beam: &SunBeam) -> f64 {
-    way_out(model, beam).z
-}
-
-/// The four nodes around a lobe and their bilinear weights.
-fn corners(model: &LightModel, beam: &SunBeam) -> ([Node; 4], [f64; 4]) {
+/// The four nodes around a lobe leaving its panel along `out` ([`way_out`])
+/// and their bilinear weights.
+fn corners(beam: &SunBeam, out: DVec3) -> ([Node; 4], [f64; 4]) {
     let group = beam.panel_group.expect("a lobe");
-    let out = way_out(model, beam);
     let step = LOBE_STEP.to_radians();
     let tilt = |along: f64| (along.atan2(out.z) / step).clamp(-LAST_NODE, LAST_NODE);
     let (a, b) = (tilt(out.x), tilt(out.y));
