@@ -244,6 +244,33 @@ fn gendaylit_reference_vectors() {
     }
 }
 
+/// gendaylit refuses a Perez sky whose parameter b comes out positive (a
+/// luminance growing without bound toward the horizon: a sun within a few
+/// degrees of it, some ε and Δ) and prints its all-dark "error sky"; so
+/// does heliodon, and says why. Left alone, the sky 0.5° below a sensor's
+/// horizon read 13 million lux. At 2° the sky is made.
+#[test]
+fn a_positive_perez_b_gives_gendaylits_dark_error_sky() {
+    // gendaylit -ang ALT 67.6 -W 260 23: "Warning: positive Perez parameter B (= …), printing error sky".
+    for (alt, b) in [(0.5, 0.171750), (1.0, 0.055450)] {
+        let computed = perez::compute(perez::Input::Irradiance { direct_normal: 260.0, diffuse_horizontal: 23.0 }, alt, 247.6, 0.0, 0.2);
+        let positive = computed.positive_b.expect("gendaylit refuses this sky");
+        assert!((positive - b).abs() <= 5e-7, "-ang {alt}: b {positive} against gendaylit's {b}");
+        let sky = Sky::new(&perez_spec(260.0, 23.0), alt, 247.6, 0.2, 0).unwrap();
+        assert!(sky.refused.as_deref().is_some_and(|why| why.contains("positive parameter b")), "-ang {alt}: {:?}", sky.refused);
+        assert!(sky.sun.is_none() && sky.ground_radiance == 0.0 && sky.diffuse_horizontal == 0.0);
+        for (a, z) in [(alt + 0.2, 247.6), (5.0, 100.0), (89.0, 0.0), (-10.0, 0.0)] {
+            assert_eq!(sky.radiance(direction_from_angles(a, z)), 0.0, "-ang {alt}: sky toward {a}° {z}°");
+        }
+    }
+    let sky = Sky::new(&perez_spec(260.0, 23.0), 2.0, 247.6, 0.2, 0).unwrap();
+    assert!(sky.refused.is_none() && sky.sun.is_some());
+    let (_, c) = sky.perez_arguments().unwrap();
+    for (got, want) in c.iter().zip([-0.573669, -0.107211, 13.877945, -3.140997, 0.409127]) {
+        assert!((got - want).abs() <= 5e-7 * 1.0001, "-ang 2: {c:?}");
+    }
+}
+
 #[test]
 fn perez_from_illuminances_and_its_horizontal_light() {
     // Illuminances give the same kind of sky; the integral of the sky over

@@ -132,5 +132,8 @@ pub fn load_for_command(path: &Path, panels: &PanelCatalog) -> Result<Scene, Str
 pub fn sky_for(scene: &Scene, spec: &SkySpec, sky_name: &str, when: LocalDateTime) -> Result<(SolarPosition, Sky), String> {
     let (position, sky) = sky_at(&scene.site, spec, &when);
     let sky = sky.map_err(|e| format!("--sky {sky_name} on {} {}: {e}", when.date, when.time))?;
+    if let Some(why) = &sky.refused {
+        eprintln!("warning: --sky {sky_name} on {} {}: {why}", when.date, when.time);
+    }
     Ok((position, sky))
 }

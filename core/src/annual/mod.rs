@@ -139,6 +139,8 @@ pub struct AnnualResult {
     pub shaded_hours: usize,
     /// Lit hours whose sky could not be made (they read 0).
     pub skipped_hours: usize,
+    /// The first of them ("month/day hour h") and why.
+    pub first_skipped: Option<String>,
     /// Total lux of every sensor for every hour, `[hour][sensor]`, when asked for.
     pub hourly: Option<Vec<Vec<f32>>>,
 }
@@ -188,6 +190,7 @@ struct Tally {
     /// Occupied hours with some shade down.
     shaded: usize,
     skipped: usize,
+    first_skipped: Option<String>,
 }
 
 impl Tally {
@@ -220,6 +223,8 @@ impl Tally {
         self.occupied += other.occupied;
         self.shaded += other.shaded;
         self.skipped += other.skipped;
+        // Runs merge in the year's order: the first run's first stays.
+        self.first_skipped = self.first_skipped.or_else(|| other.first_skipped.clone());
         self
     }
 }
@@ -234,7 +239,9 @@ pub fn hour_time(month: u32, day: u32, hour: u32) -> LocalDateTime {
 
 /// The Perez sky of one EPW hour at the site, or `None` when the hour is
 /// dark (sun below the horizon, no diffuse light); an error when the hour is
-/// lit but its sky cannot be made.
+/// lit but its sky cannot be made, or is gendaylit's dark error sky
+/// ([`Sky::refused`]): such an hour reads 0 lux, as `sensors` reads it,
+/// and is counted ([`AnnualResult::skipped_hours`]).
 pub fn hour_sky(site: &Site, when: &LocalDateTime, direct_normal: f64, diffuse_horizontal: f64) -> Result<Option<Sky>, SkyError> {
     // Most dark hours (nights) have no diffuse light: no sun position or sky is needed for them.
     if diffuse_horizontal <= 0.0 {
@@ -245,7 +252,10 @@ pub fn hour_sky(site: &Site, when: &LocalDateTime, direct_normal: f64, diffuse_h
     if sun.altitude <= 0.0 {
         return Ok(None);
     }
-    sky.map(Some)
+    match sky? {
+        Sky { refused: Some(why), .. } => Err(SkyError(why)),
+        sky => Ok(Some(sky)),
+    }
 }
 
 /// Makes the light model of the scene with the given shade groups down
@@ -488,7 +498,10 @@ pub fn annual(
         let mut hourly = Vec::new();
         for k in run * days / runs * 24..(run + 1) * days / runs * 24 {
             let hour = &weather.hours[k];
-            tally.skipped += usize::from(skies[k].is_err());
+            if let Err(why) = &skies[k] {
+                tally.skipped += 1;
+                tally.first_skipped.get_or_insert_with(|| format!("{}/{} hour {}: {why}", hour.month, hour.day, hour.hour));
+            }
             let occupied = occupancy.contains(hour.hour);
             let readings = if occupied || keep_hourly { readings(k)? } else { None };
             if occupied {
@@ -524,7 +537,14 @@ pub fn annual(
         })
         .collect();
     let hourly = keep_hourly.then(|| year.into_iter().flat_map(|(_, hours)| hours).collect());
-    Ok(AnnualResult { sensors, occupied_hours, shaded_hours: tally.shaded, skipped_hours: tally.skipped, hourly })
+    Ok(AnnualResult {
+        sensors,
+        occupied_hours,
+        shaded_hours: tally.shaded,
+        skipped_hours: tally.skipped,
+        first_skipped: tally.first_skipped,
+        hourly,
+    })
 }
 
 /// The shade groups (a bit each) that LM-83 lowers under `sky`, given the
@@ -574,5 +594,10 @@ mod tests {
         let noon = hour_time(6, 21, 13);
         assert!(matches!(hour_sky(&site, &noon, 700.0, 0.0), Ok(None)));
         assert!(matches!(hour_sky(&site, &noon, 700.0, 200.0), Ok(Some(_))));
+        // Sydney, 13 November 18:30: the sun 0.5° up, a sky gendaylit refuses (b > 0).
+        let sydney = Site::new(-33.87, 151.21, 10.0);
+        let sunset = hour_time(11, 13, 19);
+        let refused = hour_sky(&sydney, &sunset, 260.0, 23.0).expect_err("gendaylit's error sky is no sky");
+        assert!(refused.0.contains("positive parameter b"), "{refused}");
     }
 }

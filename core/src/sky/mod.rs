@@ -238,6 +238,9 @@ pub struct Sky {
     pub diffuse_horizontal: f64,
     /// Perez clearness ε and brightness Δ (Perez skies only).
     pub perez_indices: Option<(f64, f64)>,
+    /// Why the sky is dark though light was given, as gendaylit warns:
+    /// a Perez sky with a positive parameter b ([`perez::Computed::positive_b`]).
+    pub refused: Option<String>,
     distribution: Distribution,
 }
 
@@ -307,6 +310,7 @@ impl Sky {
             zenith_radiance: 0.0,
             diffuse_horizontal: 0.0,
             perez_indices: None,
+            refused: None,
             distribution: Distribution::Dark,
         };
         match *spec {
@@ -346,7 +350,14 @@ impl Sky {
                 sky.zenith_radiance = p.zenith_radiance;
                 sky.diffuse_horizontal = p.diffuse_horizontal;
                 sky.perez_indices = Some((p.clearness, p.brightness));
-                sky.distribution = Distribution::Perez(p.distribution);
+                match p.positive_b {
+                    Some(b) => {
+                        sky.refused = Some(format!(
+                            "the Perez sky with the sun {altitude:.2}° high has a positive parameter b ({b:.4}): dark, as gendaylit's error sky"
+                        ))
+                    }
+                    None => sky.distribution = Distribution::Perez(p.distribution),
+                }
             }
             SkySpec::Cie { standard_type, diffuse_illuminance, direct_illuminance } => {
                 let c = cie::compute(standard_type, diffuse_illuminance, direct_illuminance, altitude, azimuth, ground_reflectance);

@@ -151,6 +151,11 @@ pub struct Computed {
     /// The sun as a source; `None` when ε is 1 (an overcast sky) or the sun is
     /// down.
     pub sun: Option<SunSource>,
+    /// The Perez parameter b when it came out positive, a luminance that
+    /// grows without bound toward the horizon (a sun within a few degrees
+    /// of it, some ε and Δ): gendaylit then prints its "error sky", all
+    /// dark with no sun, and so is this one.
+    pub positive_b: Option<f64>,
 }
 
 fn bin(clearness: f64) -> usize {
@@ -276,6 +281,18 @@ pub fn compute(input: Input, altitude: f64, azimuth: f64, day_of_year: f64, grou
     };
     let sun_zenith = zenith.to_radians();
     let c = coefficients(sun_zenith, idx.clearness, idx.brightness);
+    if c[1] > 0.0 {
+        return Computed {
+            distribution: Perez { normalisation: 0.0, coefficients: [0.0; 5], sun },
+            clearness: idx.clearness,
+            brightness: idx.brightness,
+            zenith_radiance: 0.0,
+            diffuse_horizontal: 0.0,
+            ground_radiance: 0.0,
+            sun: None,
+            positive_b: Some(c[1]),
+        };
+    }
     let normalisation = diffuse_lux / gendaylit_integral(&c, sun_zenith) / LUMINOUS_EFFICACY;
     let sun_solid_angle = 2.0 * PI * (1.0 - SUN_HALF_ANGLE.to_radians().cos());
     let solar = direct_lux / sun_solid_angle / LUMINOUS_EFFICACY;
@@ -303,6 +320,7 @@ pub fn compute(input: Input, altitude: f64, azimuth: f64, day_of_year: f64, grou
             solid_angle: sun_solid_angle,
             radiance: solar,
         }),
+        positive_b: None,
     }
 }
 

@@ -87,8 +87,12 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     let result = annual(&model, site, &weather, &options, &|done| progress.set_position((done * 1000.0) as u64));
     progress.finish_and_clear();
     let result = result?;
-    if result.skipped_hours > 0 {
-        eprintln!("warning: {}: {} lit hours gave no Perez sky; they read 0 lux", args.weather.display(), result.skipped_hours);
+    if let Some(first) = &result.first_skipped {
+        eprintln!(
+            "warning: {}: {} lit hours gave no Perez sky; they read 0 lux (the first, {first})",
+            args.weather.display(),
+            result.skipped_hours
+        );
     }
     if let Some(path) = &args.hourly {
         std::fs::write(path, hourly_csv(&result, &weather)).map_err(|e| format!("--hourly {}: {e}", path.display()))?;

@@ -152,6 +152,9 @@ fn sun_and_sky_panel(
     }
     if let Some(sun_sky) = sun_sky {
         ui.label(format!("Sun: altitude {:.1}°, azimuth {:.1}°", sun_sky.sun.altitude, sun_sky.sun.azimuth));
+        if let Some(refused) = &sun_sky.sky.refused {
+            ui.colored_label(egui::Color32::from_rgb(230, 160, 60), refused.as_str());
+        }
     }
     ui.separator();
     if let Some(site) = site {
