@@ -81,7 +81,7 @@ impl LightModel {
                     if !crossed[..count].iter().any(|&(s, d)| s == surface && (d - hit.distance).abs() < 1e-5) {
                         crossed[count.min(15)] = (surface, hit.distance);
                         count = (count + 1).min(16);
-                        transmittance = transmittance.map(|t| t * glass.at(direction.dot(normal.as_dvec3())).0);
+                        transmittance = transmittance.map(|t| t * glass_transmittance(glass, direction.dot(normal.as_dvec3())));
                     }
                     true
                 }
@@ -253,4 +253,26 @@ impl LightModel {
         }
         by_window
     }
+}
+
+/// [`super::glass::Glass::at`]'s transmittance, remembered per thread for
+/// the last few panes and angles: one hour's shadow rays cross the same
+/// panes at the same angle thousands of times (the power in it is most of
+/// a shadow ray's own arithmetic).
+fn glass_transmittance(glass: super::glass::Glass, cos: f64) -> f64 {
+    thread_local! {
+        static LAST: std::cell::Cell<[(u64, u64, f64); 4]> = const { std::cell::Cell::new([(u64::MAX, u64::MAX, 0.0); 4]) };
+    }
+    let key = (glass.transmissivity.to_bits(), cos.to_bits());
+    LAST.with(|last| {
+        let mut entries = last.get();
+        if let Some(&(_, _, t)) = entries.iter().find(|e| (e.0, e.1) == key) {
+            return t;
+        }
+        let t = glass.at(cos).0;
+        entries.rotate_right(1);
+        entries[0] = (key.0, key.1, t);
+        last.set(entries);
+        t
+    })
 }
