@@ -140,6 +140,28 @@ fn the_viewer_runs_the_year_of_a_weather_file() {
     assert!(lit > 1000, "{lit} lit pixels of the view");
 }
 
+/// An hour of the weather file that is lit but whose shown time is after
+/// sunset (21 March 19:30 in Boston, the hour ending at 20:00 still has
+/// light): the viewer shows the dark sky `annual` reads there, and says
+/// so. It used to refuse that Perez sky with no sky before it, and a
+/// screenshot then waited for light forever.
+#[test]
+fn the_viewer_is_dark_after_sunset_in_a_lit_hour_of_the_weather() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viewer_dusk");
+    std::fs::create_dir_all(&dir).unwrap();
+    let epw = dir.join("boston.epw");
+    std::fs::write(&epw, epw::boston_epw(8760)).unwrap();
+    let hdr = dir.join("dusk.hdr");
+    let _ = std::fs::remove_file(&hdr);
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes/test_room/scene.toml");
+    let args = ["--date", "2026-03-21", "--time", "19:30", "--weather"].map(OsStr::new);
+    view(&scene, args.into_iter().chain([epw.as_os_str(), OsStr::new("--hdr"), hdr.as_os_str()]), &dir);
+    // The room's surfaces: no light at all (the glass keeps its display tint).
+    let (_, _, pixels) = read_hdr(&hdr);
+    let dark = pixels.iter().filter(|p| p.iter().all(|&c| c == 0.0)).count();
+    assert!(dark * 10 > pixels.len() * 7, "{dark} of {} pixels dark after sunset", pixels.len());
+}
+
 /// Starts `$0 view $1` and samples its CPU time (user + system, ticks of
 /// 1/100 s) every 2 s for up to 3 minutes; succeeds after three samples in
 /// a row under 5 ticks (2.5% of a core), fails if it never rests.

@@ -123,26 +123,31 @@ impl AnnualStudy {
 
 /// The weather file's sky for the shown date and time: the EPW hour that
 /// contains it (hour h covers h − 1 to h), as a Perez sky of its direct
-/// normal and diffuse horizontal irradiance.
-fn sky_from_weather(mut study: ResMut<AnnualStudy>, time: Res<SolarTime>, mut sky: ResMut<SkyChoice>) {
+/// normal and diffuse horizontal irradiance; dark while the sun is below
+/// the horizon (the hour of a sunset is lit up to it), as `annual` reads
+/// such a time: a Perez sky cannot be made with the sun down.
+fn sky_from_weather(mut study: ResMut<AnnualStudy>, time: Res<SolarTime>, site: Option<Res<Site>>, mut sky: ResMut<SkyChoice>) {
     if !study.weather_sky {
         study.hour = None;
         return;
     }
-    let Some((path, weather)) = &study.weather else { return };
+    let (Some((path, weather)), Some(site)) = (&study.weather, site) else { return };
     let when = time.0;
     let day = when.date.day_of_year().min(365) as usize - 1;
     let hour = (when.time.hours().floor() as usize).min(23);
     let row = &weather.hours[day * 24 + hour];
-    let spec = SkySpec::Perez(perez::Input::Irradiance { direct_normal: row.direct_normal, diffuse_horizontal: row.diffuse_horizontal });
+    let sun_down = crate::sun::solar_position(&site.0, &when).altitude <= 0.0;
+    let (direct_normal, diffuse_horizontal) = if sun_down { (0.0, 0.0) } else { (row.direct_normal, row.diffuse_horizontal) };
+    let spec = SkySpec::Perez(perez::Input::Irradiance { direct_normal, diffuse_horizontal });
     let label = format!(
-        "Perez sky from {}: {}/{} hour {} (DNI {:.0}, DHI {:.0} W/m²)",
+        "Perez sky from {}: {}/{} hour {} (DNI {:.0}, DHI {:.0} W/m²){}",
         path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned()),
         row.month,
         row.day,
         row.hour,
         row.direct_normal,
-        row.diffuse_horizontal
+        row.diffuse_horizontal,
+        if sun_down && row.diffuse_horizontal > 0.0 { ", dark now: the sun is down" } else { "" }
     );
     if sky.0 != spec {
         sky.0 = spec;

@@ -22,6 +22,7 @@ impl Plugin for BatchPlugin {
             Update,
             (
                 select_start_sensor.after(HeliodonSystems::SpawnScene),
+                refuse_a_start_sky_that_cannot_be_made,
                 start_on_plan.after(HeliodonSystems::Lighting),
                 take_screenshot.after(HeliodonSystems::Lighting),
             ),
@@ -107,6 +108,23 @@ fn select_start_sensor(
             );
             exit.write(AppExit::error());
         }
+    }
+}
+
+/// A batch run (`--screenshot`, `--hdr`) whose sky cannot be made before
+/// any sky was (Perez light with the sun down at `--time`, say) would wait
+/// for light forever: it ends with the reason in one line.
+fn refuse_a_start_sky_that_cannot_be_made(
+    request: Option<Res<ViewStart>>,
+    sun_sky: Option<Res<crate::ecs::SunSky>>,
+    mut rejected: MessageReader<crate::ecs::SkyRejected>,
+    mut exit: MessageWriter<AppExit>,
+) {
+    let Some(rejected) = rejected.read().last() else { return };
+    let batch = request.is_some_and(|r| r.screenshot.is_some() || r.hdr.is_some());
+    if batch && sun_sky.is_none() {
+        eprintln!("error: --sky: {}", rejected.message);
+        exit.write(AppExit::error());
     }
 }
 

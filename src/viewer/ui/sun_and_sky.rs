@@ -8,7 +8,7 @@ use bevy::prelude::*;
 use bevy::window::RequestRedraw;
 use bevy_egui::egui::{self, Ui};
 
-use crate::ecs::{ActiveScene, Site, SkyChoice, SolarTime, SunSky};
+use crate::ecs::{ActiveScene, Site, SkyChoice, SkyRejected, SolarTime, SunSky};
 use crate::render::RenderSettings;
 use crate::sky::{SkySpec, perez};
 use crate::sun::solar_position;
@@ -23,13 +23,15 @@ pub struct PlayDay(pub Option<f64>);
 /// when a value changes: writing marks them changed, and a changed time or
 /// sky starts a relight.
 #[derive(SystemParam)]
-pub struct SunAndSkyPanel<'w> {
+pub struct SunAndSkyPanel<'w, 's> {
     solar: ResMut<'w, SolarTime>,
     sky: ResMut<'w, SkyChoice>,
     site: Option<ResMut<'w, Site>>,
     sun_sky: Option<Res<'w, SunSky>>,
     active: Res<'w, ActiveScene>,
     play: ResMut<'w, PlayDay>,
+    /// Skies that could not be made (the light shown is the last sky's).
+    rejected: MessageReader<'w, 's, SkyRejected>,
 }
 
 /// Moves the clock while the day plays (and asks for the next frame).
@@ -50,7 +52,7 @@ pub fn play_the_day(time: Res<Time>, play: Res<PlayDay>, mut solar: ResMut<Solar
 /// The quick dates: equinoxes and solstices.
 const QUICK_DATES: [(&str, u32, u32); 4] = [("Mar 21", 3, 21), ("Jun 21", 6, 21), ("Sep 23", 9, 23), ("Dec 21", 12, 21)];
 
-impl SunAndSkyPanel<'_> {
+impl SunAndSkyPanel<'_, '_> {
     /// The designer's live turn of north (degrees), for the windows panel's compass.
     pub fn north_turn(&self) -> f64 {
         self.site.as_ref().map_or(0.0, |s| s.north_turn)
@@ -68,6 +70,9 @@ impl SunAndSkyPanel<'_> {
 
     /// Draws the panel; `settings` for the exposure, `note` for what was clamped.
     pub fn show(&mut self, ui: &mut Ui, settings: &mut ResMut<RenderSettings>, note: &mut Option<String>) {
+        for rejected in self.rejected.read() {
+            *note = Some(format!("{}; the light shown is the last sky's", rejected.message));
+        }
         let scene = self.active.scene.clone();
         sun_and_sky_panel(
             ui,
@@ -267,7 +272,8 @@ fn sky_controls(ui: &mut Ui, sky: &mut ResMut<SkyChoice>, note: &mut Option<Stri
         }
         SkySpec::Perez(perez::Input::Irradiance { direct_normal, diffuse_horizontal }) => {
             bounded(ui, direct_normal, 0.0..=1100.0, 1.0, "DNI ", " W/m²", note);
-            bounded(ui, diffuse_horizontal, 1.0..=600.0, 1.0, "DHI ", " W/m²", note);
+            // 0 with DNI 0 is a dark hour (a weather file's night): a sky, not a value to clamp.
+            bounded(ui, diffuse_horizontal, 0.0..=600.0, 1.0, "DHI ", " W/m²", note);
         }
         SkySpec::Cie { standard_type, diffuse_illuminance, direct_illuminance } => {
             slider(ui, standard_type, 1..=15, "CIE type", note);
