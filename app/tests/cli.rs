@@ -427,6 +427,48 @@ fn export_radiance_gives_bsdf_panels_their_data() {
 
 // ---- annual ----------------------------------------------------------------------
 
+/// An hour whose Perez sky gendaylit refuses (a positive parameter b, the
+/// sun 0.5° up) is dark in `annual`, as `sensors` reads it then, and both
+/// say why in one line; `sweep` against that year says it too. Such an
+/// hour read 13 million lux before.
+#[test]
+fn a_sky_gendaylit_refuses_reads_dark_and_is_named() {
+    let dir = scratch().join("refused_dawn");
+    std::fs::create_dir_all(&dir).unwrap();
+    let epw = dir.join("boston.epw");
+    std::fs::write(&epw, epw::boston_refused_dawn_epw()).unwrap();
+    let hourly = dir.join("hourly.csv");
+    let room = bundled_scene("test_room");
+    let args = ["annual", room.to_str().unwrap(), "--weather", epw.to_str().unwrap(), "--hourly", hourly.to_str().unwrap()];
+    let Run { code, err, .. } = heliodon(&args, &scratch());
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("1 lit hours gave no Perez sky") && err.contains("5/13 hour 5") && err.contains("positive parameter b"), "{err}");
+    let hours = std::fs::read_to_string(&hourly).unwrap();
+    let row = |hour: &str| {
+        hours
+            .lines()
+            .find(|l| l.starts_with(&format!("5,13,{hour},")))
+            .unwrap()
+            .split(',')
+            .skip(3)
+            .map(|v| v.parse::<f64>().unwrap())
+            .collect::<Vec<_>>()
+    };
+    assert!(row("5").iter().all(|&v| v == 0.0), "{:?}", row("5"));
+    assert!(row("13").iter().all(|&v| v > 100.0), "{:?}", row("13"));
+    let args =
+        ["sensors", room.to_str().unwrap(), "--date", "2025-05-13", "--time", "04:30", "--sky", "perez", "--dni", "260", "--dhi", "23"];
+    let Run { code, out, err } = heliodon(&[&args[..], &["--format", "csv"]].concat(), &scratch());
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("positive parameter b") && err.contains("gendaylit's error sky"), "{err}");
+    assert!(out.lines().skip(1).all(|l| l.split(',').nth(1) == Some("0.0")), "{out}");
+    let args =
+        ["sweep", room.to_str().unwrap(), "--material", "glass", "--vary", "transmittance=0.7..0.8:0.1", "--sensor", "back", "--weather"];
+    let Run { code, err, .. } = heliodon(&[&args[..], &[epw.to_str().unwrap()]].concat(), &scratch());
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("1 lit hours gave no Perez sky"), "{err}");
+}
+
 /// `annual` on the test room: every hour of `--hourly` is `sensors --sky
 /// perez` at the hour's middle, and DA300 and UDI are the shares of the
 /// occupied hours that file shows.

@@ -27,6 +27,17 @@ pub fn boston_clear_thirds_epw() -> String {
     })
 }
 
+/// A dark Boston year but for two hours of 13 May: hour 5 (04:30, the sun
+/// 0.5° up), whose Perez sky gendaylit refuses (parameter b > 0), and noon.
+#[allow(dead_code)]
+pub fn boston_refused_dawn_epw() -> String {
+    boston_year(8760, |month, day, hour| match (month, day, hour) {
+        (5, 13, 5) => (260.0, 23.0),
+        (5, 13, 13) => (600.0, 100.0),
+        _ => (0.0, 0.0),
+    })
+}
+
 /// `rows` hours of a Boston EPW whose (direct normal, diffuse horizontal)
 /// irradiance each hour `(month, day, hour)` gives.
 fn boston_year(rows: usize, irradiance: impl Fn(u32, u32, u32) -> (f64, f64)) -> String {

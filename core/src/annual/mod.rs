@@ -137,10 +137,9 @@ pub struct AnnualResult {
     pub occupied_hours: usize,
     /// Occupied hours with some shade group down.
     pub shaded_hours: usize,
-    /// Lit hours whose sky could not be made (they read 0).
-    pub skipped_hours: usize,
-    /// The first of them ("month/day hour h") and why.
-    pub first_skipped: Option<String>,
+    /// Lit hours whose sky could not be made (they read 0): how many, and
+    /// the first ("month/day hour h") with why ([`YearSkies::skipped`]).
+    pub skipped: Option<(usize, String)>,
     /// Total lux of every sensor for every hour, `[hour][sensor]`, when asked for.
     pub hourly: Option<Vec<Vec<f32>>>,
 }
@@ -189,8 +188,6 @@ struct Tally {
     occupied: usize,
     /// Occupied hours with some shade down.
     shaded: usize,
-    skipped: usize,
-    first_skipped: Option<String>,
 }
 
 impl Tally {
@@ -222,9 +219,6 @@ impl Tally {
         }
         self.occupied += other.occupied;
         self.shaded += other.shaded;
-        self.skipped += other.skipped;
-        // Runs merge in the year's order: the first run's first stays.
-        self.first_skipped = self.first_skipped.or_else(|| other.first_skipped.clone());
         self
     }
 }
@@ -241,7 +235,7 @@ pub fn hour_time(month: u32, day: u32, hour: u32) -> LocalDateTime {
 /// dark (sun below the horizon, no diffuse light); an error when the hour is
 /// lit but its sky cannot be made, or is gendaylit's dark error sky
 /// ([`Sky::refused`]): such an hour reads 0 lux, as `sensors` reads it,
-/// and is counted ([`AnnualResult::skipped_hours`]).
+/// and is counted ([`AnnualResult::skipped`]).
 pub fn hour_sky(site: &Site, when: &LocalDateTime, direct_normal: f64, diffuse_horizontal: f64) -> Result<Option<Sky>, SkyError> {
     // Most dark hours (nights) have no diffuse light: no sun position or sky is needed for them.
     if diffuse_horizontal <= 0.0 {
@@ -328,6 +322,16 @@ impl YearSkies {
             hour_sky(site, &hour_time(hour.month, hour.day, hour.hour), hour.direct_normal, hour.diffuse_horizontal)
         });
         Self { skies: Arc::new(skies), bins: Arc::default(), beside: Vec::new() }
+    }
+
+    /// How many lit hours have no sky ([`hour_sky`]'s errors: they read
+    /// 0), and the first of them ("month/day hour h") with why; `None`
+    /// when every lit hour has its sky.
+    pub fn skipped(&self, weather: &Weather) -> Option<(usize, String)> {
+        let mut refused = self.skies.iter().enumerate().filter_map(|(k, sky)| sky.as_ref().err().map(|why| (k, why)));
+        let (k, why) = refused.next()?;
+        let hour = &weather.hours[k];
+        Some((1 + refused.count(), format!("{}/{} hour {}: {why}", hour.month, hour.day, hour.hour)))
     }
 
     /// The skies with their radiance over `model`'s sphere bins, for
@@ -496,16 +500,12 @@ pub fn annual(
     let year = par_map(None, runs, |run| -> Result<(Tally, Vec<Vec<f32>>), String> {
         let mut tally = Tally::new(sensor_count);
         let mut hourly = Vec::new();
-        for k in run * days / runs * 24..(run + 1) * days / runs * 24 {
-            let hour = &weather.hours[k];
-            if let Err(why) = &skies[k] {
-                tally.skipped += 1;
-                tally.first_skipped.get_or_insert_with(|| format!("{}/{} hour {}: {why}", hour.month, hour.day, hour.hour));
-            }
+        let (first, end) = (run * days / runs * 24, (run + 1) * days / runs * 24);
+        for (k, (hour, &lowered)) in weather.hours.iter().zip(&down).enumerate().take(end).skip(first) {
             let occupied = occupancy.contains(hour.hour);
             let readings = if occupied || keep_hourly { readings(k)? } else { None };
             if occupied {
-                tally.count(readings.as_deref(), down[k] != 0);
+                tally.count(readings.as_deref(), lowered != 0);
             }
             if keep_hourly {
                 hourly.push(readings.map_or_else(|| vec![0.0; sensor_count], |r| r.iter().map(|v| v.0 as f32).collect()));
@@ -537,14 +537,7 @@ pub fn annual(
         })
         .collect();
     let hourly = keep_hourly.then(|| year.into_iter().flat_map(|(_, hours)| hours).collect());
-    Ok(AnnualResult {
-        sensors,
-        occupied_hours,
-        shaded_hours: tally.shaded,
-        skipped_hours: tally.skipped,
-        first_skipped: tally.first_skipped,
-        hourly,
-    })
+    Ok(AnnualResult { sensors, occupied_hours, shaded_hours: tally.shaded, skipped: year_skies.skipped(weather), hourly })
 }
 
 /// The shade groups (a bit each) that LM-83 lowers under `sky`, given the

@@ -2,7 +2,7 @@
 //! UDI, ASE hours, sDA, ASE), from one (cached) precomputation.
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use crate::annual::{AnnualOptions, AnnualResult, Occupancy, ShadedModel, annual, hour_time};
 use crate::cli::CliError;
@@ -10,6 +10,7 @@ use crate::cli::args::{Format, load_for_command, precompute_for_command, progres
 use crate::light::cache;
 use crate::panel::PanelCatalog;
 use crate::report::{csv_field, json_string};
+use crate::site::Site;
 use crate::sun::solar_position;
 use crate::weather::Weather;
 
@@ -46,29 +47,8 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
         )));
     }
     let weather = Weather::read(&args.weather)?;
-    let station = &weather.station;
     let site = &scene.site;
-    if station.is_far_from(site) {
-        eprintln!(
-            "warning: {}: the weather of {} ({:.2}°, {:.2}°, UTC{:+}) is far from the scene's site ({:.2}°, {:.2}°, UTC{:+}); the site's sun is used",
-            args.weather.display(),
-            station.name,
-            station.latitude,
-            station.longitude,
-            station.timezone,
-            site.latitude,
-            site.longitude,
-            site.timezone
-        );
-    }
-    let missing_in_daylight =
-        weather.hours.iter().filter(|h| h.missing && solar_position(site, &hour_time(h.month, h.day, h.hour)).altitude > 0.0).count();
-    if missing_in_daylight > 0 {
-        eprintln!(
-            "warning: {}: {missing_in_daylight} daylight hours have no direct or diffuse irradiance (9999); their missing values are taken as 0",
-            args.weather.display()
-        );
-    }
+    warn_about_weather(&args.weather, &weather, site);
 
     let model = precompute_for_command(scene.clone(), args.no_cache)?;
     let shaded = |down: &[usize]| precompute_for_command(std::sync::Arc::new(scene.with_shades_down(down)), args.no_cache);
@@ -87,18 +67,47 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     let result = annual(&model, site, &weather, &options, &|done| progress.set_position((done * 1000.0) as u64));
     progress.finish_and_clear();
     let result = result?;
-    if let Some(first) = &result.first_skipped {
-        eprintln!(
-            "warning: {}: {} lit hours gave no Perez sky; they read 0 lux (the first, {first})",
-            args.weather.display(),
-            result.skipped_hours
-        );
-    }
+    warn_about_skipped_hours(&args.weather, result.skipped.as_ref());
     if let Some(path) = &args.hourly {
         std::fs::write(path, hourly_csv(&result, &weather)).map_err(|e| format!("--hourly {}: {e}", path.display()))?;
     }
     print!("{}", report(&result, args.format, &args.weather));
     Ok(())
+}
+
+/// What a study at `site` should know of the weather file at `path`: a
+/// station far from the site, missing values in daylight.
+pub(crate) fn warn_about_weather(path: &Path, weather: &Weather, site: &Site) {
+    let station = &weather.station;
+    if station.is_far_from(site) {
+        eprintln!(
+            "warning: {}: the weather of {} ({:.2}°, {:.2}°, UTC{:+}) is far from the scene's site ({:.2}°, {:.2}°, UTC{:+}); the site's sun is used",
+            path.display(),
+            station.name,
+            station.latitude,
+            station.longitude,
+            station.timezone,
+            site.latitude,
+            site.longitude,
+            site.timezone
+        );
+    }
+    let missing_in_daylight =
+        weather.hours.iter().filter(|h| h.missing && solar_position(site, &hour_time(h.month, h.day, h.hour)).altitude > 0.0).count();
+    if missing_in_daylight > 0 {
+        eprintln!(
+            "warning: {}: {missing_in_daylight} daylight hours have no direct or diffuse irradiance (9999); their missing values are taken as 0",
+            path.display()
+        );
+    }
+}
+
+/// Lit hours of the weather file at `path` that had no sky
+/// ([`crate::annual::YearSkies::skipped`]).
+pub(crate) fn warn_about_skipped_hours(path: &Path, skipped: Option<&(usize, String)>) {
+    if let Some((count, first)) = skipped {
+        eprintln!("warning: {}: {count} lit hours gave no Perez sky; they read 0 lux (the first, {first})", path.display());
+    }
 }
 
 fn hourly_csv(result: &AnnualResult, weather: &Weather) -> String {

@@ -6,7 +6,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::annual::Occupancy;
+use crate::annual::{Occupancy, YearSkies};
 use crate::cli::CliError;
 use crate::cli::args::{Format, SkyArgs, load_for_command, precompute_for_command, progress_bar, sky_for};
 use crate::panel::PanelCatalog;
@@ -120,7 +120,12 @@ pub fn run(args: &SweepArgs, panels: &PanelCatalog) -> Result<(), CliError> {
         None => (0..scene.sensors.len()).collect(),
     };
     let weather = match &args.weather {
-        Some(path) => Some(Weather::read(path)?),
+        Some(path) => {
+            let weather = Weather::read(path)?;
+            super::annual::warn_about_weather(path, &weather, &scene.site);
+            super::annual::warn_about_skipped_hours(path, YearSkies::new(&scene.site, &weather).skipped(&weather).as_ref());
+            Some(weather)
+        }
         None => None,
     };
     if weather.is_some() && !scene.shades.is_empty() {

@@ -55,8 +55,8 @@ pub fn annual_panel(
     ui.label(format!("sDA300/50%  {:.1}% of point sensors", year.sda()));
     ui.label(format!("ASE1000/250 {:.1}% of point sensors", year.ase()));
     ui.label(format!("{} occupied hours", year.occupied_hours));
-    if let Some(first) = &year.first_skipped {
-        let skipped = format!("{} lit hours gave no Perez sky and read 0 lux (the first, {first})", year.skipped_hours);
+    if let Some((count, first)) = &year.skipped {
+        let skipped = format!("{count} lit hours gave no Perez sky and read 0 lux (the first, {first})");
         ui.colored_label(egui::Color32::from_rgb(230, 160, 60), skipped);
     }
     if ui.button("Save the table (CSV)").clicked() {
