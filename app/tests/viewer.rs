@@ -7,7 +7,7 @@
 mod epw;
 
 use std::ffi::OsStr;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// `heliodon view SCENE ARGS…` in a 1280 × 800 Xvfb screen, its light
@@ -100,18 +100,24 @@ fn read_hdr(path: &Path) -> (usize, usize, Vec<[f32; 3]>) {
     (width, height, pixels)
 }
 
+/// A test's folder (`name`) with the synthetic Boston year in it
+/// ([`epw::boston_epw`]), and the bundled test room: (folder, EPW, scene).
+fn test_room_and_a_year(name: &str) -> (PathBuf, PathBuf, PathBuf) {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let epw = dir.join("boston.epw");
+    std::fs::write(&epw, epw::boston_epw(8760)).unwrap();
+    (dir, epw, Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes/test_room/scene.toml"))
+}
+
 /// `view --weather FILE --annual --screenshot`: the sky of the shown hour
 /// comes from the weather file, the year runs in the background and is
 /// waited for, and its sDA and ASE are those of `heliodon annual`.
 #[test]
 fn the_viewer_runs_the_year_of_a_weather_file() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viewer_annual");
-    std::fs::create_dir_all(&dir).unwrap();
-    let epw = dir.join("boston.epw");
-    std::fs::write(&epw, epw::boston_epw(8760)).unwrap();
+    let (dir, epw, scene) = test_room_and_a_year("viewer_annual");
     let shot = dir.join("annual.png");
     let _ = std::fs::remove_file(&shot);
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes/test_room/scene.toml");
     let args = ["--date", "2026-03-21", "--time", "10:30", "--weather"].map(OsStr::new);
     let out =
         view(&scene, args.into_iter().chain([epw.as_os_str(), OsStr::new("--annual"), OsStr::new("--screenshot"), shot.as_os_str()]), &dir);
@@ -147,13 +153,9 @@ fn the_viewer_runs_the_year_of_a_weather_file() {
 /// screenshot then waited for light forever.
 #[test]
 fn the_viewer_is_dark_after_sunset_in_a_lit_hour_of_the_weather() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viewer_dusk");
-    std::fs::create_dir_all(&dir).unwrap();
-    let epw = dir.join("boston.epw");
-    std::fs::write(&epw, epw::boston_epw(8760)).unwrap();
+    let (dir, epw, scene) = test_room_and_a_year("viewer_dusk");
     let hdr = dir.join("dusk.hdr");
     let _ = std::fs::remove_file(&hdr);
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/scenes/test_room/scene.toml");
     let args = ["--date", "2026-03-21", "--time", "19:30", "--weather"].map(OsStr::new);
     view(&scene, args.into_iter().chain([epw.as_os_str(), OsStr::new("--hdr"), hdr.as_os_str()]), &dir);
     // The room's surfaces: no light at all (the glass keeps its display tint).
