@@ -7,6 +7,10 @@
 //! and the room reads the soffit's light, or the dark under a wall, in its
 //! ceiling and floor. This is discontinuity meshing along the model's own
 //! contact lines, not along shadow edges.
+//!
+//! The same large faces keep clutter apart ([`LargeFaces::separating`]):
+//! small parts on the two sides of a door leaf or a wall (a door's handles
+//! outside and in) see different light, so they never share a cluster.
 
 use std::collections::HashMap;
 
@@ -27,17 +31,72 @@ const MIN_CONTACT: f32 = 0.01;
 /// A contact cuts the pieces within this distance of it, m.
 const CONTACT_REACH: f32 = 0.01;
 
-/// Per surface, the planes of the faces that meet it along a line inside
-/// it, where its patches are cut. Only faces of surfaces of at least
-/// `min_area` (m²) cut: walls, slabs and roofs make the steps of the light
-/// that matter; a chair leg or a window frame would cut a floor or a wall
-/// into slivers for a step no sensor sees.
-pub fn contact_cuts(triangles: &[Triangle], surfaces: &[Surface], min_area: f32) -> Vec<Vec<CutPlane>> {
-    let mut cutter = vec![false; triangles.len()];
-    for surface in surfaces.iter().filter(|s| s.area >= min_area) {
-        cutter[surface.triangles.start as usize..surface.triangles.end as usize].fill(true);
+/// A plane: its unit normal and offset (the points x with normal · x = offset).
+pub type Plane = (Vec3, f32);
+
+/// The faces of the model's large surfaces, found by place: those of at
+/// least `min_area` (m²). Walls, slabs, roofs and doors make the steps of
+/// the light that matter; a chair leg or a window frame would cut a floor
+/// or a wall into slivers for a step no sensor sees.
+pub struct LargeFaces<'a> {
+    triangles: &'a [Triangle],
+    /// Per triangle, its surface's area (m²).
+    surface_area: Vec<f32>,
+    grid: Grid,
+}
+
+impl<'a> LargeFaces<'a> {
+    pub fn new(triangles: &'a [Triangle], surfaces: &[Surface], min_area: f32) -> Self {
+        let mut surface_area = vec![0.0; triangles.len()];
+        for surface in surfaces {
+            surface_area[surface.triangles.start as usize..surface.triangles.end as usize].fill(surface.area);
+        }
+        let large: Vec<bool> = surface_area.iter().map(|&a| a >= min_area).collect();
+        LargeFaces { triangles, surface_area, grid: Grid::new(triangles, &large) }
     }
-    let grid = Grid::new(triangles, &cutter);
+
+    /// The planes (unit normal, offset) of the faces of surfaces of at
+    /// least the area of one side of the cube (lo, hi) that pass through it
+    /// with room on both sides, each plane once, in the order of the faces:
+    /// what parts of the cube lie apart. (A book's or a chair seat's faces
+    /// in a cube of half a metre do not part it; a door leaf does.)
+    pub fn separating(&self, lo: Vec3, hi: Vec3) -> Vec<Plane> {
+        let (centre, half) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+        let min_area = 4.0 * half.x * half.y;
+        let mut planes: Vec<Plane> = Vec::new();
+        for t in self.grid.near(lo, hi) {
+            if self.surface_area[t as usize] < min_area {
+                continue;
+            }
+            let face = &self.triangles[t as usize];
+            let (face_lo, face_hi) = bounds(std::slice::from_ref(face));
+            if face_lo.cmpgt(hi).any() || face_hi.cmplt(lo).any() {
+                continue;
+            }
+            let normal = face.normal();
+            let offset = normal.dot(face.vertices[0]);
+            let (middle, reach) = (normal.dot(centre), normal.abs().dot(half));
+            if middle - reach > offset - IN_PLANE || middle + reach < offset + IN_PLANE {
+                continue;
+            }
+            if !planes.iter().any(|&(n, d)| same_plane((n, d), (normal, offset))) {
+                planes.push((normal, offset));
+            }
+        }
+        planes
+    }
+}
+
+/// Whether two planes (unit normal, offset) are one, facing either way.
+fn same_plane((n, d): Plane, (m, e): Plane) -> bool {
+    let cos = n.dot(m);
+    cos.abs() > 0.9999 && (d - cos.signum() * e).abs() < IN_PLANE
+}
+
+/// Per surface, the planes of the large faces that meet it along a line
+/// inside it, where its patches are cut.
+pub fn contact_cuts(large: &LargeFaces, surfaces: &[Surface]) -> Vec<Vec<CutPlane>> {
+    let (triangles, grid) = (large.triangles, &large.grid);
     surfaces
         .iter()
         .map(|surface| {
@@ -59,11 +118,7 @@ pub fn contact_cuts(triangles: &[Triangle], surfaces: &[Surface], min_area: f32)
                     near: (p.min(q) - Vec3::splat(CONTACT_REACH), p.max(q) + Vec3::splat(CONTACT_REACH)),
                 };
                 let length = p.distance(q);
-                let same = |c: &CutPlane| {
-                    let cos = c.normal.dot(cut.normal);
-                    cos.abs() > 0.9999 && (c.offset - cos.signum() * cut.offset).abs() < IN_PLANE
-                };
-                match cuts.iter_mut().find(|(c, _)| same(c)) {
+                match cuts.iter_mut().find(|(c, _)| same_plane((c.normal, c.offset), (cut.normal, cut.offset))) {
                     Some((c, total)) => {
                         c.near = (c.near.0.min(cut.near.0), c.near.1.max(cut.near.1));
                         *total += length;
@@ -229,7 +284,7 @@ mod tests {
         let beside = quad(1, [[0.0, 3.0, 0.5], [4.0, 3.0, 0.5], [4.0, 3.0, 3.0], [0.0, 3.0, 3.0]]);
         let lying = quad(2, [[1.0, 1.0, 0.0], [2.0, 1.0, 0.0], [2.0, 2.0, 0.0], [1.0, 2.0, 0.0]]);
         let (triangles, surfaces) = surfaces(&[slab, wall, beside, lying]);
-        let cuts = contact_cuts(&triangles, &surfaces, 0.01);
+        let cuts = contact_cuts(&LargeFaces::new(&triangles, &surfaces, 0.01), &surfaces);
         // The slab: one plane, the wall's (y = 0), cutting along its foot.
         assert_eq!(cuts[0].len(), 1, "{:?}", cuts[0]);
         let cut = cuts[0][0];

@@ -336,8 +336,8 @@ fn build(
             CutPlane::around_window(w.normal, &triangles[range.start as usize..range.end as usize])
         })
         .collect();
-    let contacts = contacts::contact_cuts(&triangles, &surfaces, patches::CLUTTER * parsed.patch_size * parsed.patch_size);
-    let patches = patches::subdivide(&triangles, &mut surfaces, &sizing, &clusterable, &window_planes, &contacts);
+    let large = contacts::LargeFaces::new(&triangles, &surfaces, patches::CLUTTER * parsed.patch_size * parsed.patch_size);
+    let patches = patches::subdivide(&triangles, &mut surfaces, &sizing, &clusterable, &window_planes, &large);
     let viewpoints = sensors::viewpoints(&parsed)?;
     let bounds = bounds(&triangles);
     let focus = focus.unwrap_or(bounds);

@@ -28,11 +28,12 @@
 //! mean normal. The cluster's patch is listed under its first surface; the
 //! others have none of their own.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::ops::Range;
 
 use glam::Vec3;
 
+use super::contacts::{LargeFaces, Plane, contact_cuts};
 use super::{Surface, Triangle};
 
 /// One lighting patch.
@@ -374,17 +375,21 @@ const CLUSTER_LAYER: f32 = 0.1;
 /// The clusters of clutter: per surface, its cluster (index into the
 /// returned list of member lists), for the surfaces that `clusterable`
 /// allows, that are small where they lie and that no window plane cuts.
-/// Clutter on the two sides of a window's plane (frames outside and in)
-/// never shares a cluster.
+/// Clutter on the two sides of a window's plane (frames outside and in),
+/// or of a large face crossing its cube (a door's handles outside and in,
+/// [`LargeFaces::separating`]), never shares a cluster.
 fn clusters(
     triangles: &[Triangle],
     surfaces: &[Surface],
     sizing: &PatchSizing,
     clusterable: &[bool],
     cuts: &[CutPlane],
+    large: &LargeFaces,
 ) -> (Vec<Option<u32>>, Vec<Vec<u32>>) {
-    type Key = (u32, u8, [i64; 3], i64, Vec<(u32, bool)>);
+    type Key = (u32, u8, [i64; 3], i64, Vec<(u32, bool)>, Vec<bool>);
     let mut keys: BTreeMap<Key, u32> = BTreeMap::new();
+    // Per cube (its corner and side), the large faces' planes crossing it.
+    let mut separators: HashMap<([i64; 3], u32), Vec<Plane>> = HashMap::new();
     let mut members: Vec<Vec<u32>> = Vec::new();
     let mut cluster_of = vec![None; surfaces.len()];
     for (index, surface) in surfaces.iter().enumerate() {
@@ -407,7 +412,12 @@ fn clusters(
         let direction = (2 * axis + usize::from(n[axis] < 0.0)) as u8;
         let next = members.len() as u32;
         let layer = (centroid[axis] / CLUSTER_LAYER).floor() as i64;
-        let cluster = *keys.entry((surface.material, direction, cube, layer, sides)).or_insert(next);
+        let planes = separators.entry((cube, side.to_bits())).or_insert_with(|| {
+            let corner = Vec3::new(cube[0] as f32, cube[1] as f32, cube[2] as f32) * side;
+            large.separating(corner, corner + Vec3::splat(side))
+        });
+        let apart = planes.iter().map(|&(normal, offset)| normal.dot(centroid) > offset).collect();
+        let cluster = *keys.entry((surface.material, direction, cube, layer, sides, apart)).or_insert(next);
         if cluster == next {
             members.push(Vec::new());
         }
@@ -418,20 +428,20 @@ fn clusters(
 }
 
 /// Cuts every surface into patches no larger than `sizing` allows, along
-/// the window planes `cuts` and along each surface's `contacts` (per
-/// surface, the faces that meet it; see [`super::contacts`]), gathers the
-/// clutter among the surfaces `clusterable` allows into clusters, and sets
-/// each surface's patch range.
+/// the window planes `cuts` and along where the `large` faces meet it (see
+/// [`super::contacts`]), gathers the clutter among the surfaces
+/// `clusterable` allows into clusters, and sets each surface's patch range.
 pub fn subdivide(
     triangles: &[Triangle],
     surfaces: &mut [Surface],
     sizing: &PatchSizing,
     clusterable: &[bool],
     cuts: &[CutPlane],
-    contacts: &[Vec<CutPlane>],
+    large: &LargeFaces,
 ) -> PatchMesh {
     let mut mesh = PatchMesh::default();
-    let (cluster_of, members) = clusters(triangles, surfaces, sizing, clusterable, cuts);
+    let contacts = contact_cuts(large, surfaces);
+    let (cluster_of, members) = clusters(triangles, surfaces, sizing, clusterable, cuts, large);
     for index in 0..surfaces.len() {
         let first_patch = mesh.patches.len() as u32;
         if let Some(cluster) = cluster_of[index] {
@@ -567,7 +577,8 @@ mod tests {
     fn a_wall_becomes_a_grid_of_square_patches_that_conserve_area() {
         let tris = quad(4.0, 3.0);
         let mut surfaces = vec![surface_of(&tris)];
-        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[], &[vec![]]);
+        let large = LargeFaces::new(&tris, &surfaces, f32::INFINITY);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[], &large);
         assert_eq!(mesh.patches.len(), 8 * 6);
         assert_eq!(surfaces[0].patches, 0..48);
         for patch in &mesh.patches {
@@ -591,7 +602,8 @@ mod tests {
     fn a_partial_cell_keeps_its_share() {
         let tris = quad(1.2, 0.5);
         let mut surfaces = vec![surface_of(&tris)];
-        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[], &[vec![]]);
+        let large = LargeFaces::new(&tris, &surfaces, f32::INFINITY);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[], &large);
         let mut areas: Vec<f32> = mesh.patches.iter().map(|p| p.area).collect();
         areas.sort_by(f32::total_cmp);
         assert_eq!(areas.len(), 3);
@@ -611,7 +623,8 @@ mod tests {
             })
             .collect();
         let mut surfaces = vec![surface_of(&tris)];
-        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[], &[vec![]]);
+        let large = LargeFaces::new(&tris, &surfaces, f32::INFINITY);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], &[], &large);
         assert_eq!(mesh.triangles.len(), 6);
         assert_eq!(mesh.patches.len(), 2);
         let total: f32 = mesh.patches.iter().map(|p| p.area).sum();
@@ -642,7 +655,8 @@ mod tests {
             surfaces.push(Surface { triangles: start..tris.len() as u32, ..surface_of(&square) });
         }
         let clusterable = vec![true; surfaces.len()];
-        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &clusterable, &[], &vec![vec![]; 40]);
+        let large = LargeFaces::new(&tris, &surfaces, f32::INFINITY);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &clusterable, &[], &large);
         assert_eq!(mesh.patches.len(), 2, "{:?}", mesh.patches.iter().map(|p| p.normal).collect::<Vec<_>>());
         let area: f32 = mesh.patches.iter().map(|p| p.area).sum();
         assert!((area - 0.4).abs() < 1e-5, "{area}");
@@ -673,9 +687,53 @@ mod tests {
             tris.extend(square.iter().copied());
             surfaces.push(Surface { triangles: start..tris.len() as u32, ..surface_of(&square) });
         }
-        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[true; 3], &[], &vec![vec![]; 3]);
+        let large = LargeFaces::new(&tris, &surfaces, f32::INFINITY);
+        let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[true; 3], &[], &large);
         let heights: Vec<f32> = mesh.patches.iter().map(|p| p.centroid.z).collect();
         assert_eq!(mesh.patches.len(), 2, "{heights:?}");
         assert!(heights.iter().any(|z| (z - 0.135).abs() < 1e-4) && heights.iter().any(|z| (z - 0.32).abs() < 1e-4), "{heights:?}");
+    }
+
+    /// A door's handles outside and in (clutter in one cube, facing the same
+    /// way, in one layer) are two patches: the door leaf between them, a
+    /// large face crossing their cube, parts them. Without it, one.
+    #[test]
+    fn a_doors_handles_outside_and_in_are_not_one_patch() {
+        let handle_patches = |with_door: bool| {
+            let mut tris = Vec::new();
+            let mut surfaces = Vec::new();
+            let mut add = |tris: &mut Vec<Triangle>, material: u32, part: Vec<Triangle>| {
+                let start = tris.len() as u32;
+                tris.extend(part.iter().map(|t| Triangle { material, ..*t }));
+                surfaces.push(Surface { material, triangles: start..tris.len() as u32, ..surface_of(&part) });
+            };
+            for y in [0.19, 0.35] {
+                let handle = quad(0.1, 0.03)
+                    .into_iter()
+                    .map(|t| Triangle { vertices: t.vertices.map(|p| Vec3::new(p.x + 0.6, p.z + y, 1.02)), ..t });
+                add(&mut tris, 0, handle.collect());
+            }
+            if with_door {
+                // The leaf, 4 cm thick: its outer face at y = 0.25 facing -y, its inner at 0.29 facing +y.
+                let outer: Vec<Triangle> =
+                    quad(1.0, 2.0).into_iter().map(|t| Triangle { vertices: t.vertices.map(|p| p + Vec3::Y * 0.25), ..t }).collect();
+                let inner = outer
+                    .iter()
+                    .map(|t| Triangle { vertices: [t.vertices[0], t.vertices[2], t.vertices[1]].map(|p| p + Vec3::Y * 0.04), ..*t })
+                    .collect();
+                add(&mut tris, 1, outer);
+                add(&mut tris, 1, inner);
+            }
+            let clusterable = vec![true; surfaces.len()];
+            let large = LargeFaces::new(&tris, &surfaces, CLUTTER * 0.25);
+            let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &clusterable, &[], &large);
+            mesh.patches.iter().filter(|p| p.material == 0).map(|p| p.centroid.y).collect::<Vec<f32>>()
+        };
+        let without = handle_patches(false);
+        assert_eq!(without.len(), 1, "{without:?}");
+        let mut with = handle_patches(true);
+        with.sort_by(f32::total_cmp);
+        assert_eq!(with.len(), 2, "{with:?}");
+        assert!((with[0] - 0.205).abs() < 1e-4 && (with[1] - 0.365).abs() < 1e-4, "{with:?}");
     }
 }
