@@ -40,32 +40,35 @@ pub type Plane = (Vec3, f32);
 /// or a wall into slivers for a step no sensor sees.
 pub struct LargeFaces<'a> {
     triangles: &'a [Triangle],
-    /// Per triangle, its surface's area (m²).
-    surface_area: Vec<f32>,
+    /// Per triangle, its surface's span: the longest side of its box (m).
+    surface_span: Vec<f32>,
     grid: Grid,
 }
 
 impl<'a> LargeFaces<'a> {
     pub fn new(triangles: &'a [Triangle], surfaces: &[Surface], min_area: f32) -> Self {
-        let mut surface_area = vec![0.0; triangles.len()];
+        let mut large = vec![false; triangles.len()];
+        let mut surface_span = vec![0.0; triangles.len()];
         for surface in surfaces {
-            surface_area[surface.triangles.start as usize..surface.triangles.end as usize].fill(surface.area);
+            let own = surface.triangles.start as usize..surface.triangles.end as usize;
+            let (lo, hi) = bounds(&triangles[own.clone()]);
+            surface_span[own.clone()].fill((hi - lo).max_element());
+            large[own].fill(surface.area >= min_area);
         }
-        let large: Vec<bool> = surface_area.iter().map(|&a| a >= min_area).collect();
-        LargeFaces { triangles, surface_area, grid: Grid::new(triangles, &large) }
+        LargeFaces { triangles, surface_span, grid: Grid::new(triangles, &large) }
     }
 
-    /// The planes (unit normal, offset) of the faces of surfaces of at
-    /// least the area of one side of the cube (lo, hi) that pass through it
-    /// with room on both sides, each plane once, in the order of the faces:
-    /// what parts of the cube lie apart. (A book's or a chair seat's faces
-    /// in a cube of half a metre do not part it; a door leaf does.)
+    /// The planes (unit normal, offset) of the faces of surfaces spanning
+    /// at least the side of the cube (lo, hi) that pass through it with
+    /// room on both sides, each plane once, in the order of the faces: what
+    /// parts of the cube lie apart. (A book's or a chair seat's faces in a
+    /// cube of half a metre do not part it; a door leaf or a window's frame
+    /// does.)
     pub fn separating(&self, lo: Vec3, hi: Vec3) -> Vec<Plane> {
         let (centre, half) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
-        let min_area = 4.0 * half.x * half.y;
         let mut planes: Vec<Plane> = Vec::new();
         for t in self.grid.near(lo, hi) {
-            if self.surface_area[t as usize] < min_area {
+            if self.surface_span[t as usize] < 2.0 * half.x {
                 continue;
             }
             let face = &self.triangles[t as usize];
