@@ -23,7 +23,7 @@ use crate::sky::SkyPatches;
 
 const MAGIC: &[u8; 8] = b"HELIOLT\0";
 /// Bump when the model or its layout changes.
-const FORMAT: u32 = 9;
+const FORMAT: u32 = 10;
 
 /// What happened to the cache.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -447,6 +447,13 @@ impl LightModel {
             .collect()
     }
 
+    /// Whether the sun may light patch side `side`: not a diffuse side
+    /// whose gather met no sky at all.
+    fn may_be_sunlit(&self, side: u32) -> bool {
+        !matches!(self.surface_of_patch(side / 2), Surface::Diffuse(_))
+            || !self.side_gathers[side as usize].daylight_coefficients.is_empty()
+    }
+
     /// A patch's render triangles with their cumulative areas.
     pub(super) fn patch_triangles(&self, patch: usize) -> Vec<([DVec3; 3], f64)> {
         let range = self.scene.patches.patches[patch].triangles.clone();
@@ -474,10 +481,17 @@ impl LightModel {
             count * points.len()
         };
         // The first rays' landings keep the sun's first bounce; more rays,
-        // a second stratified set, refine the sky and form factors.
+        // a second stratified set, refine the sky and form factors. Only
+        // landings on sides the sun may reach are kept: a diffuse side none
+        // of whose rays (those aimed at the windows it faces included) saw
+        // the sky is dark to the sun (as `openings` has it), and the landings
+        // are most of a sensor's memory (none in a windowless room).
         let bounce_rays = trace(per_point, &mut coefficients, &mut hits);
-        let bounce: Vec<(u32, f32, [f32; 3])> =
-            hits.iter().map(|h| (h.side, (h.weight / bounce_rays as f64) as f32, h.point.as_vec3().to_array())).collect();
+        let bounce: Vec<(u32, f32, [f32; 3])> = hits
+            .iter()
+            .filter(|h| self.may_be_sunlit(h.side))
+            .map(|h| (h.side, (h.weight / bounce_rays as f64) as f32, h.point.as_vec3().to_array()))
+            .collect();
         let rays = bounce_rays + trace(more_per_point, &mut coefficients, &mut hits);
         SensorGeometry::new(Gather::from_raw(coefficients, &hits, rays), sun_points, normal, bounce)
     }
