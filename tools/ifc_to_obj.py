@@ -11,9 +11,16 @@ up), except spaces and openings. Faces take the surface style IfcOpenShell
 reports: a transparent style becomes glass of visible transmittance
 --transmittance (rendering transparency is not a photometric quantity; say
 what the glazing is), an opaque one a diffuse reflectance from its colour
-(Radiance's RGB weights, clamped to 0.05-0.9). Each IfcSpace gets a sensor
-grid 0.8 m above its floor, 0.3 m in from its walls, named after the space.
-The site's latitude and longitude come from IfcSite when given there.
+(Radiance's RGB weights, clamped to 0.05-0.9). An IfcWindow with no
+transparent face at all (early-design exports draw a window as one plain
+box) is glazed, and said so: one pane, the outline of its faces in the
+plane of most area (the wall's opening has its own reveals). Each IfcSpace gets sensors 0.8 m
+above its floor on a --spacing grid, 0.3 m in from the walls of its box,
+named after the space (its LongName; see `space_names` where long names repeat):
+a sensor grid where the space fills its box, otherwise the grid's points
+over the space's floor as point sensors `<space>/<k>` (an L-shaped
+corridor's box reaches into the rooms beside it). The site's latitude and
+longitude come from IfcSite when given there.
 """
 import argparse
 import os
@@ -26,7 +33,10 @@ try:
 except ImportError:
     sys.exit("tools/ifc_to_obj.py needs IfcOpenShell: pip install ifcopenshell")
 
-SKIP = ("IfcSpace", "IfcOpeningElement", "IfcAnnotation", "IfcGrid", "IfcVirtualElement")
+# Not things light meets: zones (an IFC4 IfcExternalSpatialElement is the
+# volume around the building, a closed box over every façade), voids, notes.
+SKIP = ("IfcSpace", "IfcExternalSpatialElement", "IfcSpatialZone", "IfcOpeningElement", "IfcAnnotation", "IfcGrid",
+        "IfcVirtualElement")
 
 
 def angle(parts):
@@ -40,6 +50,86 @@ def angle(parts):
 
 def name_of(text):
     return re.sub(r"[^A-Za-z0-9_]+", "_", text or "").strip("_") or "unnamed"
+
+
+def space_names(spaces):
+    """Per IfcSpace, its name: the LongName where no other space has it; the
+    Name and LongName where a few share it (two flats' "Living Room"); the
+    Name where most do (a long name every space has names none)."""
+    def count(values):
+        seen = {}
+        for v in values:
+            seen[v] = seen.get(v, 0) + 1
+        return seen
+    longs = count(s.LongName for s in spaces)
+    chosen = []
+    for s in spaces:
+        if s.LongName and longs[s.LongName] == 1:
+            chosen.append(name_of(s.LongName))
+        elif s.LongName and 2 * longs[s.LongName] <= len(spaces):
+            chosen.append(name_of(f"{s.Name or ''} {s.LongName}"))
+        else:
+            chosen.append(name_of(s.Name or s.LongName))
+    return chosen
+
+
+def pane(points, tris):
+    """A window drawn as a solid, as one pane: the convex outline of its faces
+    in the plane of most area (one face of a box; of a skylight drawn as
+    stacked, overlapping sheets, the outline of the largest), as triangles
+    (corner indices) facing that plane's way. The wall's opening has its own
+    reveals; glass as a whole solid would be crossed twice or more."""
+    planes = {}
+    for t in range(len(tris) // 3):
+        a, b, c = (points[tris[3 * t + k]] for k in range(3))
+        u, v = [b[i] - a[i] for i in range(3)], [c[i] - a[i] for i in range(3)]
+        n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+        length = sum(x * x for x in n) ** 0.5
+        if length == 0:
+            continue
+        unit = [x / length for x in n]
+        # The plane, to a degree and a centimetre.
+        key = tuple(round(x * 60) for x in unit) + (round(sum(x * y for x, y in zip(unit, a)) * 100),)
+        area, normal, corners = planes.get(key, (0.0, unit, set()))
+        planes[key] = (area + 0.5 * length, normal, corners | {tris[3 * t + k] for k in range(3)})
+    if not planes:
+        return []
+    _, n, corners = max(planes.values(), key=lambda p: p[0])
+    # In-plane axes, then the outline (Andrew's monotone chain).
+    helper = [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0]
+    e1 = [n[1] * helper[2] - n[2] * helper[1], n[2] * helper[0] - n[0] * helper[2], n[0] * helper[1] - n[1] * helper[0]]
+    e2 = [n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2], n[0] * e1[1] - n[1] * e1[0]]
+    flat = sorted((sum(x * y for x, y in zip(points[k], e1)), sum(x * y for x, y in zip(points[k], e2)), k) for k in corners)
+
+    def turn(o, a, b):
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower, upper = [], []
+    for p in flat:
+        while len(lower) >= 2 and turn(lower[-2], lower[-1], p) <= 1e-12:
+            lower.pop()
+        lower.append(p)
+    for p in reversed(flat):
+        while len(upper) >= 2 and turn(upper[-2], upper[-1], p) <= 1e-12:
+            upper.pop()
+        upper.append(p)
+    outline = [p[2] for p in lower[:-1] + upper[:-1]]
+    # Counter-clockwise about e1 × e2 = n: the fan faces the plane's way.
+    return [(outline[0], outline[i], outline[i + 1]) for i in range(1, len(outline) - 1)]
+
+
+def over_floor(point, floor):
+    """Whether (x, y) lies over one of the floor's triangles (xy corners)."""
+    x, y = point
+    for (ax, ay), (bx, by), (cx, cy) in floor:
+        d = (bx - ax) * (cy - ay) - (cx - ax) * (by - ay)
+        if abs(d) < 1e-12:
+            continue
+        u = ((x - ax) * (cy - ay) - (cx - ax) * (y - ay)) / d
+        v = ((bx - ax) * (y - ay) - (x - ax) * (by - ay)) / d
+        if u >= -1e-9 and v >= -1e-9 and u + v <= 1 + 1e-9:
+            return True
+    return False
 
 
 def main():
@@ -57,6 +147,8 @@ def main():
     settings.set("use-world-coords", True)
     os.makedirs(a.out, exist_ok=True)
     vertices, faces, materials, spaces, skipped = [], {}, {}, [], {}
+    names = dict(zip((s.id() for s in model.by_type("IfcSpace")), space_names(model.by_type("IfcSpace"))))
+    glazed_windows = 0
     iterator = ifcopenshell.geom.iterator(settings, model)
     if not iterator.initialize():
         sys.exit(f"{a.ifc}: no geometry IfcOpenShell can read")
@@ -70,7 +162,12 @@ def main():
             if points:
                 lo = [min(p[k] for p in points) for k in range(3)]
                 hi = [max(p[k] for p in points) for k in range(3)]
-                spaces.append((name_of(product.LongName or product.Name), lo, hi))
+                tris = geometry.faces
+                corners = [[points[tris[3 * t + k]] for k in range(3)] for t in range(len(tris) // 3)]
+                # The floor: the faces of the space's solid that face down.
+                floor = [[p[:2] for p in c] for c in corners
+                         if (c[1][0] - c[0][0]) * (c[2][1] - c[0][1]) - (c[2][0] - c[0][0]) * (c[1][1] - c[0][1]) < 0]
+                spaces.append((names[product.id()], lo, hi, floor))
         elif product.is_a() in SKIP or any(product.is_a(kind) for kind in SKIP):
             skipped[product.is_a()] = skipped.get(product.is_a(), 0) + 1
         else:
@@ -79,13 +176,23 @@ def main():
             styles = geometry.materials
             ids = geometry.material_ids
             tris = geometry.faces
+            def transparency(style):
+                return style.transparency if style is not None and style.transparency == style.transparency else 0.0
+            face_styles = [styles[ids[t]] if ids and ids[t] >= 0 and ids[t] < len(styles) else None for t in range(len(tris) // 3)]
+            glaze_all = product.is_a("IfcWindow") and face_styles and all(transparency(st) <= 0.3 for st in face_styles)
+            glazed_windows += bool(glaze_all)
+            if glaze_all:
+                materials.setdefault("window_glass", ("glass", a.transmittance))
+                faces.setdefault("window_glass", []).extend(tuple(base + k + 1 for k in t) for t in pane(points, tris))
             for t in range(len(tris) // 3):
-                style = styles[ids[t]] if ids and ids[t] >= 0 and ids[t] < len(styles) else None
+                style = face_styles[t]
+                if glaze_all:
+                    continue
                 if style is None:
                     key = "default"
                     materials.setdefault(key, ("Kd", 0.5))
                 else:
-                    transparent = style.transparency if style.transparency == style.transparency else 0.0
+                    transparent = transparency(style)
                     diffuse = style.diffuse
                     colour = (diffuse.r(), diffuse.g(), diffuse.b()) if diffuse is not None else (0.6, 0.6, 0.6)
                     key = name_of(style.name)
@@ -119,18 +226,35 @@ def main():
         f.write(f'name = "{os.path.basename(a.ifc)}"\n\n[site]\nlatitude = {latitude:.4f}\nlongitude = {longitude:.4f}\n'
                 f'timezone = {a.timezone}\n\n[model]\nobj = "model.obj"\n')
         used = set()
-        for name, lo, hi in spaces:
+        partial = 0
+        for name, lo, hi, floor in spaces:
             if hi[0] - lo[0] < 0.6 + a.spacing or hi[1] - lo[1] < 0.6 + a.spacing:
                 continue
             while name in used:
                 name += "_"
             used.add(name)
-            f.write(f'\n[[sensor_grids]]\nname = "{name}"\nmin = [{lo[0] + 0.3:.3f}, {lo[1] + 0.3:.3f}]\n'
-                    f'max = [{hi[0] - 0.3:.3f}, {hi[1] - 0.3:.3f}]\nheight = {lo[2] + 0.8:.3f}\nspacing = {a.spacing}\n')
+            (x0, y0), (x1, y1), height = (lo[0] + 0.3, lo[1] + 0.3), (hi[0] - 0.3, hi[1] - 0.3), lo[2] + 0.8
+            # The grid's points as heliodon places them: centres of spacing cells from min.
+            nx, ny = int((x1 - x0) / a.spacing + 1e-9), int((y1 - y0) / a.spacing + 1e-9)
+            points = [(x0 + (i + 0.5) * a.spacing, y0 + (j + 0.5) * a.spacing) for j in range(ny) for i in range(nx)]
+            inside = [k for k, p in enumerate(points) if over_floor(p, floor)]
+            if not floor or len(inside) == len(points):
+                f.write(f'\n[[sensor_grids]]\nname = "{name}"\nmin = [{x0:.3f}, {y0:.3f}]\n'
+                        f'max = [{x1:.3f}, {y1:.3f}]\nheight = {height:.3f}\nspacing = {a.spacing}\n')
+                continue
+            partial += 1
+            for k in inside:
+                x, y = points[k]
+                f.write(f'\n[[sensors]]\nname = "{name}/{k}"\nposition = [{x:.3f}, {y:.3f}, {height:.3f}]\nnormal = [0.0, 0.0, 1.0]\n')
     for kind, count in sorted(skipped.items()):
         print(f"skipped {count} {kind}", file=sys.stderr)
+    if glazed_windows:
+        print(f"{glazed_windows} IfcWindow with no transparent face: glazed as one pane, the outline of their faces in the plane of most area (glass, transmittance {a.transmittance})",
+              file=sys.stderr)
+    if partial:
+        print(f"{partial} spaces do not fill their box: point sensors over their floors instead of a grid", file=sys.stderr)
     print(f"{len(vertices)} vertices, {sum(len(v) for v in faces.values())} triangles, {len(materials)} materials, "
-          f"{len(used)} sensor grids -> {a.out}")
+          f"{len(used)} spaces with sensors -> {a.out}")
 
 
 if __name__ == "__main__":
