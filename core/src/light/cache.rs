@@ -183,7 +183,7 @@ pub fn through_cache<T>(
     let stored = fs::create_dir_all(dir).and_then(|_| {
         // Write then rename, so a reader never sees half a file.
         let partial = temporary_path(&path);
-        fs::write(&partial, encode(&save(&value), key))?;
+        write_file(&partial, &save(&value), key)?;
         fs::rename(&partial, &path)
     });
     if stored.is_ok() {
@@ -425,11 +425,13 @@ fn read_header(bytes: &[u8], key: u64) -> Result<(u64, u64), String> {
     Ok((u64_at(20), u64_at(28)))
 }
 
-fn encode(payload: &[u8], key: u64) -> Vec<u8> {
-    let mut out = Vec::with_capacity(payload.len() + HEADER);
-    out.extend_from_slice(&header(key, payload.len() as u64, Fnv::new().bytes(payload).0));
-    out.extend_from_slice(payload);
-    out
+/// Writes the header and `payload` to `path`, the payload as it is: not
+/// copied behind the header in memory first (a large model's payload is
+/// hundreds of megabytes).
+fn write_file(path: &Path, payload: &[u8], key: u64) -> io::Result<()> {
+    let mut file = fs::File::create(path)?;
+    file.write_all(&header(key, payload.len() as u64, Fnv::new().bytes(payload).0))?;
+    file.write_all(payload)
 }
 
 fn decode(bytes: &[u8], key: u64) -> Result<&[u8], String> {
