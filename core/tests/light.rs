@@ -478,6 +478,45 @@ fn rays_aimed_at_windows_read_the_sky_hemisphere_rays_read_with_less_noise() {
     assert!(aimed_rms < 0.5 * hemisphere_rms, "{aimed_rms} against {hemisphere_rms}");
 }
 
+/// Appends `quads` to the room's OBJ beside the scene file `path`, their
+/// faces numbered after the room's vertices.
+fn add_to_room(path: &Path, quads: &quad_obj::QuadObj) {
+    let mut obj = std::fs::read_to_string(path.with_file_name("room.obj")).unwrap();
+    let offset = obj.lines().filter(|l| l.starts_with("v ")).count();
+    for line in quads.text().lines().skip(1) {
+        let line = match line.strip_prefix("f ") {
+            Some(f) => {
+                format!("f {}", f.split(' ').map(|i| (i.parse::<usize>().unwrap() + offset).to_string()).collect::<Vec<_>>().join(" "))
+            }
+            None => line.to_string(),
+        };
+        obj.push_str(&line);
+        obj.push('\n');
+    }
+    std::fs::write(path.with_file_name("room.obj"), obj).unwrap();
+}
+
+/// A window under an opaque face in its own plane (an IFC zone exported as
+/// a box over the façade) is named in one warning; a face in that plane
+/// beside the window, or none, says nothing.
+#[test]
+fn a_window_under_an_opaque_face_in_its_plane_is_named() {
+    let warnings = |name: &str, x: [f64; 2]| {
+        let path = on_a_ground(name, 10.0, 10.0, true);
+        let mut quads = quad_obj::QuadObj::new("room.mtl");
+        // In the window's plane (y = 0, the pane at x 1-3, z 0.9-2.3), facing out.
+        quads.quad("wall", [[x[0], 0.0, 0.5], [x[0], 0.0, 2.8], [x[1], 0.0, 2.8], [x[1], 0.0, 0.5]]);
+        add_to_room(&path, &quads);
+        load_scene(&path, &PanelCatalog::new()).unwrap().warnings
+    };
+    let over = warnings("covered_window", [0.5, 3.5]);
+    assert_eq!(over.len(), 1, "{over:?}");
+    assert!(over[0].message.starts_with("1 windows lie under an opaque face in their own plane"), "{}", over[0]);
+    assert!(over[0].message.contains("100% covered"), "{}", over[0]);
+    let beside = warnings("window_beside_a_face", [3.2, 4.5]);
+    assert!(beside.is_empty(), "{beside:?}");
+}
+
 /// A pane modelled as a glass box 2 cm thick (as BIM exports write them)
 /// is read as one pane, with one warning: one window, and the light of a
 /// single glass face, not of two (τ²).
@@ -487,7 +526,6 @@ fn a_glass_box_is_read_as_one_pane() {
         let path = on_a_ground(name, 10.0, 10.0, true);
         if thick {
             // The pane's far face (facing into the room, 2 cm in) and its four edges.
-            let mut obj = std::fs::read_to_string(path.with_file_name("room.obj")).unwrap();
             let mut quads = quad_obj::QuadObj::new("room.mtl");
             let (x0, x1, z0, z1, y) = (1.0, 3.0, 0.9, 2.3, 0.02);
             quads.quad("glass", [[1.0, y, 0.9], [1.0, y, 2.3], [3.0, y, 2.3], [3.0, y, 0.9]]);
@@ -495,20 +533,7 @@ fn a_glass_box_is_read_as_one_pane() {
             quads.quad("glass", [[x0, 0.0, z1], [x1, 0.0, z1], [x1, y, z1], [x0, y, z1]]);
             quads.quad("glass", [[x0, 0.0, z0], [x0, 0.0, z1], [x0, y, z1], [x0, y, z0]]);
             quads.quad("glass", [[x1, 0.0, z0], [x1, y, z0], [x1, y, z1], [x1, 0.0, z1]]);
-            // Appended after the room's vertices: renumber the new faces.
-            let offset = obj.lines().filter(|l| l.starts_with("v ")).count();
-            for line in quads.text().lines().skip(1) {
-                let line = match line.strip_prefix("f ") {
-                    Some(f) => format!(
-                        "f {}",
-                        f.split(' ').map(|i| (i.parse::<usize>().unwrap() + offset).to_string()).collect::<Vec<_>>().join(" ")
-                    ),
-                    None => line.to_string(),
-                };
-                obj.push_str(&line);
-                obj.push('\n');
-            }
-            std::fs::write(path.with_file_name("room.obj"), obj).unwrap();
+            add_to_room(&path, &quads);
         }
         load_scene(&path, &PanelCatalog::new()).unwrap()
     };

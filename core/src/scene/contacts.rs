@@ -88,6 +88,42 @@ impl<'a> LargeFaces<'a> {
         }
         planes
     }
+
+    /// The share (0-1) of surface `surface`'s area that a large face of
+    /// another material `opaque` allows lies over, in its own plane: a
+    /// window under a zone box an export drew over the façade, which one
+    /// ray tracer sees and another does not.
+    pub fn covered_share(&self, surface: &Surface, opaque: impl Fn(u32) -> bool) -> f32 {
+        let own = surface.triangles.start as usize..surface.triangles.end as usize;
+        let tris = &self.triangles[own.clone()];
+        let (lo, hi) = bounds(tris);
+        let (normal, offset) = (surface.normal, surface.normal.dot(tris[0].vertices[0]));
+        let over: Vec<Triangle> = self
+            .grid
+            .near(lo - Vec3::splat(IN_PLANE), hi + Vec3::splat(IN_PLANE))
+            .into_iter()
+            .filter(|&t| !own.contains(&(t as usize)))
+            .map(|t| self.triangles[t as usize])
+            .filter(|f| opaque(f.material) && f.normal().dot(normal).abs() > 0.9999)
+            .filter(|f| f.vertices.iter().all(|&v| (normal.dot(v) - offset).abs() <= IN_PLANE))
+            .collect();
+        if over.is_empty() {
+            return 0.0;
+        }
+        let flat = Flat::new(normal, &over);
+        // Four points per triangle, each standing for a quarter of its area.
+        const POINTS: [[f32; 3]; 4] =
+            [[1.0 / 3.0; 3], [2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0], [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0]];
+        let covered: f32 = tris
+            .iter()
+            .map(|t| {
+                let inside =
+                    POINTS.iter().filter(|w| flat.holds(t.vertices[0] * w[0] + t.vertices[1] * w[1] + t.vertices[2] * w[2])).count();
+                t.area() * inside as f32 / 4.0
+            })
+            .sum();
+        covered / surface.area.max(f32::MIN_POSITIVE)
+    }
 }
 
 /// Whether two planes (unit normal, offset) are one, facing either way.

@@ -337,6 +337,23 @@ fn build(
         })
         .collect();
     let large = contacts::LargeFaces::new(&triangles, &surfaces, patches::CLUTTER * parsed.patch_size * parsed.patch_size);
+    let covered: Vec<(usize, f32)> = windows
+        .iter()
+        .map(|w| large.covered_share(&surfaces[w.surface as usize], |m| !materials[m as usize].kind.transmits()))
+        .enumerate()
+        .filter(|&(_, share)| share >= 0.5)
+        .collect();
+    if let Some(&(first, share)) = covered.first() {
+        warnings.push(SceneWarning {
+            location: Location::file(&obj_path),
+            message: format!(
+                "{} windows lie under an opaque face in their own plane (the first, window #{first} of material '{}', {:.0}% covered): whether light passes there is up to the ray tracer, and Radiance and heliodon may disagree; remove the covering faces (an IFC zone exported as geometry?)",
+                covered.len(),
+                materials[windows[first].material as usize].name,
+                share * 100.0
+            ),
+        });
+    }
     let patches = patches::subdivide(&triangles, &mut surfaces, &sizing, &clusterable, &window_planes, &large);
     let viewpoints = sensors::viewpoints(&parsed)?;
     let bounds = bounds(&triangles);
