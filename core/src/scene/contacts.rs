@@ -10,7 +10,9 @@
 //!
 //! The same large faces keep clutter apart ([`LargeFaces::separating`]):
 //! small parts on the two sides of a door leaf or a wall (a door's handles
-//! outside and in) see different light, so they never share a cluster.
+//! outside and in) see different light, so they never share a cluster. And
+//! they find windows that an opaque face covers in their own plane
+//! ([`LargeFaces::covered_share`]), which the loader names.
 
 use std::collections::HashMap;
 
@@ -82,15 +84,15 @@ impl<'a> LargeFaces<'a> {
             if middle - reach > offset - IN_PLANE || middle + reach < offset + IN_PLANE {
                 continue;
             }
-            if !planes.iter().any(|&(n, d)| same_plane((n, d), (normal, offset))) {
+            if !planes.iter().any(|&plane| same_plane(plane, (normal, offset))) {
                 planes.push((normal, offset));
             }
         }
         planes
     }
 
-    /// The share (0-1) of surface `surface`'s area that a large face of
-    /// another material `opaque` allows lies over, in its own plane: a
+    /// The share (0-1) of `surface`'s area that large faces in its own
+    /// plane lie over, counting faces of the materials `opaque` accepts: a
     /// window under a zone box an export drew over the façade, which one
     /// ray tracer sees and another does not.
     pub fn covered_share(&self, surface: &Surface, opaque: impl Fn(u32) -> bool) -> f32 {
