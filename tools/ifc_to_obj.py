@@ -118,6 +118,11 @@ def pane(points, tris):
     return [(outline[0], outline[i], outline[i + 1]) for i in range(1, len(outline) - 1)]
 
 
+def transparency(style):
+    """A surface style's transparency (0 when none is given)."""
+    return style.transparency if style is not None and style.transparency == style.transparency else 0.0
+
+
 def over_floor(point, floor):
     """Whether (x, y) lies over one of the floor's triangles (xy corners)."""
     x, y = point
@@ -176,8 +181,6 @@ def main():
             styles = geometry.materials
             ids = geometry.material_ids
             tris = geometry.faces
-            def transparency(style):
-                return style.transparency if style is not None and style.transparency == style.transparency else 0.0
             face_styles = [styles[ids[t]] if ids and ids[t] >= 0 and ids[t] < len(styles) else None for t in range(len(tris) // 3)]
             glaze_all = product.is_a("IfcWindow") and face_styles and all(transparency(st) <= 0.3 for st in face_styles)
             glazed_windows += bool(glaze_all)
