@@ -365,6 +365,26 @@ impl LightModel {
         self.group_of_surface[surface as usize]
     }
 
+    /// What patch side `side` ([`side_of`]) gathered: for tools that follow
+    /// the light (`examples/light_into_room.rs`).
+    pub fn side_gather(&self, side: usize) -> &Gather {
+        &self.side_gathers[side]
+    }
+
+    /// What sensor `sensor` gathered (its first `rays_per_sensor` rays and
+    /// the sky rays after them).
+    pub fn sensor_gather(&self, sensor: usize) -> &Gather {
+        &self.sensors[sensor].gather
+    }
+
+    /// The light patch side `side` sends out in `lighting`, RGB W/m²: its
+    /// reflectance times all its irradiance (none for glass).
+    pub fn side_exitance(&self, lighting: &Lighting, side: usize) -> [f64; 3] {
+        let Some(rho) = self.side_reflectance(side) else { return [0.0; 3] };
+        let c = &lighting.sides[side];
+        [0, 1, 2].map(|k| rho[k] * (c.sun + c.sky + c.indirect[k]))
+    }
+
     /// Each sensor's share of its hemisphere (cosine-weighted) that sees the
     /// open sky or ground directly, through no window: near 0 in a room,
     /// 1 in the open. A sensor with much of it stands outside every room.
