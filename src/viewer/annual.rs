@@ -13,7 +13,7 @@ use bevy::prelude::*;
 
 use super::background::Background;
 use super::schedule::ViewerSystems;
-use crate::annual::{AnnualOptions, AnnualResult, SensorYear, annual};
+use crate::annual::{AnnualOptions, AnnualResult, SensorYear, YearSkies, annual, missing_in_daylight};
 use crate::ecs::{ActiveScene, LightCacheDir, LightEngine, Site, SkyChoice, SolarTime};
 use crate::sky::{SkySpec, perez};
 use crate::weather::Weather;
@@ -98,6 +98,9 @@ pub struct AnnualStudy {
     pub requested: bool,
     /// What the sensors are coloured by, if anything.
     pub colour_by: Option<Metric>,
+    /// What the open weather file means at a site ([`weather_notes`]), and
+    /// the site it was worked out for.
+    pub notes: Option<(crate::site::Site, Vec<String>)>,
 }
 
 impl AnnualStudy {
@@ -107,6 +110,7 @@ impl AnnualStudy {
         self.weather = Some((path.to_path_buf(), Arc::new(weather)));
         self.weather_sky = true;
         self.result = Background::default();
+        self.notes = None;
         Ok(())
     }
 
@@ -119,6 +123,21 @@ impl AnnualStudy {
     pub fn year(&self) -> Option<&AnnualResult> {
         self.result.values.as_ref().and_then(|r| r.as_ref().ok())
     }
+}
+
+/// What a weather file means at `site`, said as soon as it is open (the
+/// lines `annual` warns with, for the annual study and sweeps alike):
+/// daylight hours with missing irradiance, lit hours with no Perez sky.
+pub fn weather_notes(site: &crate::site::Site, weather: &Weather) -> Vec<String> {
+    let mut notes = Vec::new();
+    let missing = missing_in_daylight(site, weather);
+    if missing > 0 {
+        notes.push(format!("{missing} daylight hours have no irradiance (9999): read as 0"));
+    }
+    if let Some((count, first)) = YearSkies::new(site, weather).skipped(weather) {
+        notes.push(format!("{count} lit hours give no Perez sky and read 0 lux (the first, {first})"));
+    }
+    notes
 }
 
 /// The weather file's sky for the shown date and time: the EPW hour that
@@ -217,4 +236,24 @@ fn draw_metric_markers(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::viewer::files::epw;
+
+    /// The panel says what `annual` warns about as soon as the file is
+    /// open: a lit hour whose Perez sky gendaylit refuses (13 May 04:30 in
+    /// Boston, the sun 0.5° up) is named; 9° further west, where the sun is
+    /// not up yet at that hour, the same file says nothing.
+    #[test]
+    fn a_weather_files_hours_without_a_sky_are_said_when_it_opens() {
+        let weather = Weather::parse_epw(&epw::boston_refused_dawn_epw(), Path::new("boston.epw")).unwrap();
+        let notes = weather_notes(&crate::site::Site::new(42.37, -71.01, -5.0), &weather);
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(notes[0].starts_with("1 lit hours give no Perez sky") && notes[0].contains("5/13 hour 5"), "{notes:?}");
+        let west = weather_notes(&crate::site::Site::new(42.37, -80.0, -5.0), &weather);
+        assert!(west.is_empty(), "{west:?}");
+    }
 }

@@ -178,7 +178,7 @@ fn remember_opened_scenes(mut spawned: MessageReader<SceneSpawned>, active: Res<
 
 #[cfg(test)]
 #[path = "../../tests/support/epw.rs"]
-mod epw;
+pub(super) mod epw;
 
 #[cfg(test)]
 mod tests {

@@ -231,6 +231,16 @@ pub fn hour_time(month: u32, day: u32, hour: u32) -> LocalDateTime {
     }
 }
 
+/// How many hours of `weather` with the sun up at `site` have missing
+/// irradiance (9999): they are read as 0.
+pub fn missing_in_daylight(site: &Site, weather: &Weather) -> usize {
+    weather
+        .hours
+        .iter()
+        .filter(|h| h.missing && crate::sun::solar_position(site, &hour_time(h.month, h.day, h.hour)).altitude > 0.0)
+        .count()
+}
+
 /// The Perez sky of one EPW hour at the site, or `None` when the hour is
 /// dark (sun below the horizon, no diffuse light); an error when the hour is
 /// lit but its sky cannot be made, or is gendaylit's dark error sky

@@ -4,14 +4,13 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::annual::{AnnualOptions, AnnualResult, Occupancy, ShadedModel, annual, hour_time};
+use crate::annual::{AnnualOptions, AnnualResult, Occupancy, ShadedModel, annual, missing_in_daylight};
 use crate::cli::CliError;
 use crate::cli::args::{Format, load_for_command, precompute_for_command, progress_bar};
 use crate::light::cache;
 use crate::panel::PanelCatalog;
 use crate::report::{csv_field, json_string};
 use crate::site::Site;
-use crate::sun::solar_position;
 use crate::weather::Weather;
 
 #[derive(clap::Args, Debug)]
@@ -92,8 +91,7 @@ pub(crate) fn warn_about_weather(path: &Path, weather: &Weather, site: &Site) {
             site.timezone
         );
     }
-    let missing_in_daylight =
-        weather.hours.iter().filter(|h| h.missing && solar_position(site, &hour_time(h.month, h.day, h.hour)).altitude > 0.0).count();
+    let missing_in_daylight = missing_in_daylight(site, weather);
     if missing_in_daylight > 0 {
         eprintln!(
             "warning: {}: {missing_in_daylight} daylight hours have no direct or diffuse irradiance (9999); their missing values are taken as 0",

@@ -1,11 +1,12 @@
-//! The annual panel: open a weather file (EPW), take the sky from it, run
+//! The annual panel: open a weather file (EPW), say what it means at the
+//! site (as `annual` warns), take the sky from it, run
 //! the year in the background, read sDA and ASE, colour the sensors by a
 //! metric with its legend, and save the table as CSV.
 
 use bevy::prelude::*;
 use bevy_egui::egui::{self, Ui};
 
-use crate::viewer::annual::{AnnualStudy, Metric, metric_colour};
+use crate::viewer::annual::{AnnualStudy, Metric, metric_colour, weather_notes};
 
 /// Draws the panel; what happened (a file opened, a CSV written) goes to `note`.
 pub fn annual_panel(
@@ -25,17 +26,23 @@ pub fn annual_panel(
             });
         }
     });
-    let Some((_, weather)) = &study.weather else {
+    let Some(weather) = study.weather.as_ref().map(|(_, weather)| weather.clone()) else {
         ui.label("Open an EPW file (or start with view --weather FILE) for the year's sky and the annual study.");
         return;
     };
     let station = &weather.station;
     ui.label(format!("{} ({:.2}°, {:.2}°, UTC{:+})", station.name, station.latitude, station.longitude, station.timezone));
+    let warning = egui::Color32::from_rgb(255, 210, 40);
     if site.is_some_and(|site| station.is_far_from(site)) {
-        ui.colored_label(
-            egui::Color32::from_rgb(255, 210, 40),
-            "far from the scene's site: its sun is the site's, its weather the station's",
-        );
+        ui.colored_label(warning, "far from the scene's site: its sun is the site's, its weather the station's");
+    }
+    if let Some(site) = site
+        && study.notes.as_ref().is_none_or(|(at, _)| at != site)
+    {
+        study.notes = Some((*site, weather_notes(site, &weather)));
+    }
+    for note in study.notes.iter().flat_map(|(_, notes)| notes) {
+        ui.colored_label(warning, note);
     }
     ui.checkbox(&mut study.weather_sky, "Sky from the weather file (this hour's Perez sky)");
     match study.progress() {
@@ -55,10 +62,6 @@ pub fn annual_panel(
     ui.label(format!("sDA300/50%  {:.1}% of point sensors", year.sda()));
     ui.label(format!("ASE1000/250 {:.1}% of point sensors", year.ase()));
     ui.label(format!("{} occupied hours", year.occupied_hours));
-    if let Some((count, first)) = &year.skipped {
-        let skipped = format!("{count} lit hours gave no Perez sky and read 0 lux (the first, {first})");
-        ui.colored_label(egui::Color32::from_rgb(230, 160, 60), skipped);
-    }
     if ui.button("Save the table (CSV)").clicked() {
         *note = Some(crate::viewer::ui::sensors::write_export("heliodon-annual.csv", &year.csv()));
     }
