@@ -13,7 +13,7 @@ use bevy::prelude::*;
 
 use super::background::Background;
 use super::schedule::ViewerSystems;
-use crate::annual::{AnnualOptions, AnnualResult, SensorYear, YearSkies, annual, missing_in_daylight};
+use crate::annual::{AnnualOptions, AnnualResult, SensorYear, YearSkies, annual, missing_in_daylight_note, skipped_hours_note};
 use crate::ecs::{ActiveScene, LightCacheDir, LightEngine, Site, SkyChoice, SolarTime};
 use crate::sky::{SkySpec, perez};
 use crate::weather::Weather;
@@ -129,15 +129,8 @@ impl AnnualStudy {
 /// lines `annual` warns with, for the annual study and sweeps alike):
 /// daylight hours with missing irradiance, lit hours with no Perez sky.
 pub fn weather_notes(site: &crate::site::Site, weather: &Weather) -> Vec<String> {
-    let mut notes = Vec::new();
-    let missing = missing_in_daylight(site, weather);
-    if missing > 0 {
-        notes.push(format!("{missing} daylight hours have no irradiance (9999): read as 0"));
-    }
-    if let Some((count, first)) = YearSkies::new(site, weather).skipped(weather) {
-        notes.push(format!("{count} lit hours give no Perez sky and read 0 lux (the first, {first})"));
-    }
-    notes
+    let skipped = YearSkies::new(site, weather).skipped(weather);
+    missing_in_daylight_note(site, weather).into_iter().chain(skipped.as_ref().map(skipped_hours_note)).collect()
 }
 
 /// The weather file's sky for the shown date and time: the EPW hour that
@@ -252,7 +245,7 @@ mod tests {
         let weather = Weather::parse_epw(&epw::boston_refused_dawn_epw(), Path::new("boston.epw")).unwrap();
         let notes = weather_notes(&crate::site::Site::new(42.37, -71.01, -5.0), &weather);
         assert_eq!(notes.len(), 1, "{notes:?}");
-        assert!(notes[0].starts_with("1 lit hours give no Perez sky") && notes[0].contains("5/13 hour 5"), "{notes:?}");
+        assert!(notes[0].starts_with("1 lit hours gave no Perez sky") && notes[0].contains("5/13 hour 5"), "{notes:?}");
         let west = weather_notes(&crate::site::Site::new(42.37, -80.0, -5.0), &weather);
         assert!(west.is_empty(), "{west:?}");
     }

@@ -231,14 +231,23 @@ pub fn hour_time(month: u32, day: u32, hour: u32) -> LocalDateTime {
     }
 }
 
-/// How many hours of `weather` with the sun up at `site` have missing
-/// irradiance (9999): they are read as 0.
-pub fn missing_in_daylight(site: &Site, weather: &Weather) -> usize {
-    weather
+/// What is said (the CLI's warnings, the viewer's annual panel) of the
+/// hours of `weather` with the sun up at `site` and missing irradiance
+/// (9999), if any: they are read as 0.
+pub fn missing_in_daylight_note(site: &Site, weather: &Weather) -> Option<String> {
+    let missing = weather
         .hours
         .iter()
         .filter(|h| h.missing && crate::sun::solar_position(site, &hour_time(h.month, h.day, h.hour)).altitude > 0.0)
-        .count()
+        .count();
+    (missing > 0)
+        .then(|| format!("{missing} daylight hours have no direct or diffuse irradiance (9999); their missing values are taken as 0"))
+}
+
+/// What is said of the lit hours with no Perez sky, given as
+/// [`YearSkies::skipped`] gives them.
+pub fn skipped_hours_note((count, first): &(usize, String)) -> String {
+    format!("{count} lit hours gave no Perez sky; they read 0 lux (the first, {first})")
 }
 
 /// The Perez sky of one EPW hour at the site, or `None` when the hour is

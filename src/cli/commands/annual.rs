@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::annual::{AnnualOptions, AnnualResult, Occupancy, ShadedModel, annual, missing_in_daylight};
+use crate::annual::{AnnualOptions, AnnualResult, Occupancy, ShadedModel, annual, missing_in_daylight_note, skipped_hours_note};
 use crate::cli::CliError;
 use crate::cli::args::{Format, load_for_command, precompute_for_command, progress_bar};
 use crate::light::cache;
@@ -91,20 +91,16 @@ pub(crate) fn warn_about_weather(path: &Path, weather: &Weather, site: &Site) {
             site.timezone
         );
     }
-    let missing_in_daylight = missing_in_daylight(site, weather);
-    if missing_in_daylight > 0 {
-        eprintln!(
-            "warning: {}: {missing_in_daylight} daylight hours have no direct or diffuse irradiance (9999); their missing values are taken as 0",
-            path.display()
-        );
+    if let Some(note) = missing_in_daylight_note(site, weather) {
+        eprintln!("warning: {}: {note}", path.display());
     }
 }
 
 /// Lit hours of the weather file at `path` that had no sky
 /// ([`crate::annual::YearSkies::skipped`]).
 pub(crate) fn warn_about_skipped_hours(path: &Path, skipped: Option<&(usize, String)>) {
-    if let Some((count, first)) = skipped {
-        eprintln!("warning: {}: {count} lit hours gave no Perez sky; they read 0 lux (the first, {first})", path.display());
+    if let Some(skipped) = skipped {
+        eprintln!("warning: {}: {}", path.display(), skipped_hours_note(skipped));
     }
 }
 
