@@ -9,7 +9,10 @@
 //! shadow-volume triangles drawn per frame.
 //!
 //! 1280 × 720 unless `HELIODON_BENCH_FRAME=WxH` says otherwise (1920x1080
-//! on a GPU machine).
+//! on a GPU machine). `HELIODON_BENCH_SCENES` adds scene files (separated as
+//! in `PATH`, each named by its folder): real models, drawn in full from their
+//! first view. `HELIODON_BENCH_SECONDS` is each case's measurement time (15 s),
+//! shorter where device time is scarce.
 
 #[path = "../../tests/support/office_floor.rs"]
 mod office_floor;
@@ -26,9 +29,10 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use heliodon::bevy::prelude::*;
 use heliodon::bevy::render::render_resource::PollType;
 use heliodon::bevy::render::renderer::RenderDevice;
-use heliodon::ecs::ActiveScene;
+use heliodon::ecs::{ActiveScene, SunSky};
+use heliodon::render::RayModel;
 use heliodon::render::offscreen::{OffscreenRequest, frame_ready, offscreen_app};
-use heliodon::render::sun_pass::SunPassInput;
+use heliodon::render::sun_pass::{SunPassFrame, SunPassInput};
 use heliodon::render::{PhysicalUnits, RenderMode, RenderSettings, framing};
 use heliodon::sky::SkySpec;
 use heliodon::time::{Date, LocalDateTime, TimeOfDay};
@@ -123,21 +127,41 @@ fn ready_app(scene: PathBuf, mode: RenderMode) -> (App, String) {
     }
     let counts = match &app.world().resource::<SunPassInput>().0 {
         Some(frame) => format!(
-            "{} draws per frame ({} direction passes, {} lights), {} shadow-volume triangles, {} lit triangles drawn once per light",
+            "{} draws per frame ({} direction passes, {} lights), {} shadow-volume triangles, {} lit triangles ({} drawn per frame, each light's share); made in {:.1} ms when the sun moves",
             frame.draw_count(),
             frame.passes.len(),
             frame.lights().count(),
             frame.volumes.len() / 3,
-            frame.lit.len() / 27,
+            frame.surfaces.lit.len() / 27,
+            frame.lit_triangles_drawn(),
+            sun_pass_geometry_ms(&app, frame),
         ),
         None => "no sun pass".into(),
     };
     (app, counts)
 }
 
+/// The main world's share of a sun move: the sun pass's volumes and each
+/// light's lit triangles made again (the median of five).
+fn sun_pass_geometry_ms(app: &App, frame: &SunPassFrame) -> f64 {
+    let scene = app.world().resource::<ActiveScene>().scene.clone().expect("the scene is loaded");
+    let model = app.world().resource::<RayModel>().0.clone();
+    let sun = app.world().resource::<SunSky>().sky.sun_up().expect("the sun is up");
+    let mut times: Vec<f64> = (0..5)
+        .map(|_| {
+            let start = std::time::Instant::now();
+            std::hint::black_box(SunPassFrame::new(&scene, &model, frame.surfaces.clone(), &sun, 0));
+            start.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[2]
+}
+
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("render");
-    group.sample_size(10).measurement_time(Duration::from_secs(15));
+    let seconds = std::env::var("HELIODON_BENCH_SECONDS").ok().and_then(|s| s.parse().ok()).unwrap_or(15);
+    group.sample_size(10).measurement_time(Duration::from_secs(seconds));
     let (width, height) = frame_size();
     let temp = std::env::temp_dir();
     let mut cases: Vec<(String, PathBuf, RenderMode)> = heliodon::BUNDLED_SCENES
@@ -152,6 +176,10 @@ fn bench(c: &mut Criterion) {
     cases.push(("furnished office floor full".into(), floor, RenderMode::Full));
     let ground = room_on_ground::room_on_a_ground(&temp.join("heliodon-bench-room-on-ground"), 400.0, 300.0, true);
     cases.push(("room on a 400 x 300 m ground full".into(), ground, RenderMode::Full));
+    for scene in std::env::var_os("HELIODON_BENCH_SCENES").iter().flat_map(std::env::split_paths) {
+        let folder = scene.parent().and_then(Path::file_name).map(|name| name.to_string_lossy().into_owned());
+        cases.push((format!("{} full", folder.unwrap_or_else(|| scene.display().to_string())), scene, RenderMode::Full));
+    }
     for (label, scene, mode) in cases {
         let (mut app, counts) = ready_app(scene, mode);
         println!("{label}: {counts}");

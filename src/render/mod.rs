@@ -26,7 +26,7 @@ use bevy::render::view::Msaa;
 use crate::ecs::{ActiveScene, HeliodonSystems, LightEngine, LightingState, SunSky};
 use crate::light::{Channels, LightModel, side_of};
 use crate::scene::{DEFAULT_FOV, MaterialKind, Scene, Viewpoint};
-use sun_pass::{SunPassFrame, SunPassInput, SunPassPlugin, SunPassView, lit_vertices};
+use sun_pass::{SunPassFrame, SunPassInput, SunPassPlugin, SunPassSurfaces, SunPassView};
 use surfaces::{SurfaceLightingPlugin, side_value};
 
 pub struct HeliodonRenderPlugin;
@@ -216,8 +216,8 @@ pub type PictureCamera = (With<SunPassView>, Without<PhysicalUnits>);
 #[derive(Component, Clone, Copy, Default)]
 pub struct PhysicalUnits;
 
-/// The sun pass's lit surfaces and ray-query model of a scene (by address).
-type PerScene = (usize, Arc<Vec<f32>>, Arc<LightModel>);
+/// The sun pass's surfaces and ray-query model of a scene (by address).
+type PerScene = (usize, Arc<SunPassSurfaces>, Arc<LightModel>);
 
 /// The active scene's ray-query model (no light gathered): its panel
 /// windows and their lobes, for the sun pass and the viewer's lobe arrows.
@@ -242,13 +242,13 @@ fn update_sun_pass(
         input.0 = None;
         return;
     };
-    // The lit surfaces and a ray-query model (panel windows and their
-    // lobes) are made once per scene.
+    // The sun pass's surfaces and a ray-query model (panel windows and
+    // their lobes) are made once per scene.
     let scene_id = Arc::as_ptr(scene) as usize;
-    let (vertices, model) = match &*per_scene {
-        Some((id, vertices, model)) if *id == scene_id => (vertices.clone(), model.clone()),
+    let (surfaces, model) = match &*per_scene {
+        Some((id, surfaces, model)) if *id == scene_id => (surfaces.clone(), model.clone()),
         _ => {
-            let made = (Arc::new(lit_vertices(scene)), Arc::new(LightModel::unlit(scene.clone())));
+            let made = (Arc::new(SunPassSurfaces::new(scene)), Arc::new(LightModel::unlit(scene.clone())));
             *per_scene = Some((scene_id, made.0.clone(), made.1.clone()));
             commands.insert_resource(RayModel(made.1.clone()));
             made
@@ -264,7 +264,7 @@ fn update_sun_pass(
         return;
     };
     *generation += 1;
-    let frame = SunPassFrame::new(scene, &model, vertices, &sun, *generation);
+    let frame = SunPassFrame::new(scene, &model, surfaces, &sun, *generation);
     input.0 = Some(Arc::new(frame));
 }
 

@@ -12,9 +12,8 @@
 //! T-junctions, duplicated faces) every triangle keeps its own closed volume,
 //! so the stencil count stays exact whatever the model's quality.
 
-use std::collections::HashMap;
-
 use glam::{Vec3, Vec4};
+use rustc_hash::FxHashMap;
 
 /// Triangles whose normal is this close to perpendicular to the light cast
 /// no volume (their shadow has no area).
@@ -37,45 +36,134 @@ pub struct ShadowVolume {
 /// away from the camera so that face counts as outside; biased sides would
 /// move the shadow's edges.
 pub fn shadow_volume(casters: &[[Vec3; 3]], to_light: Vec3) -> ShadowVolume {
-    let infinity = (-to_light).extend(0.0);
-    let mut oriented: Vec<[Vec3; 3]> = Vec::with_capacity(casters.len());
-    for &[a, b, c] in casters {
-        let normal = (b - a).cross(c - a);
-        let facing = normal.dot(to_light);
-        if facing.abs() <= EDGE_ON * normal.length() {
-            continue;
-        }
-        oriented.push(if facing > 0.0 { [a, b, c] } else { [a, c, b] });
-    }
-    // Directed edges by their end points; an edge meeting its reverse cancels.
-    let key = |v: Vec3| v.to_array().map(f32::to_bits);
-    let mut open_edges: HashMap<([u32; 3], [u32; 3]), u32> = HashMap::new();
-    for t in &oriented {
-        for (p, q) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-            let reverse = (key(q), key(p));
-            match open_edges.get_mut(&reverse) {
-                Some(count) if *count > 0 => *count -= 1,
-                _ => *open_edges.entry((key(p), key(q))).or_default() += 1,
+    Casters::new(casters.to_vec()).volume(to_light)
+}
+
+/// Casters with their shared edges found once: which edges meet does not
+/// depend on the light, so a volume along each new direction is one pass
+/// over the triangles (the sun pass keeps a scene's opaque casters so).
+#[derive(Debug, Clone, Default)]
+pub struct Casters {
+    triangles: Vec<[Vec3; 3]>,
+    /// What meets edge k of triangle t (index 3t + k, from corner k to k + 1).
+    meets: Vec<Meeting>,
+    /// The edges of each place where three or more casters meet.
+    crowds: Vec<Vec<u32>>,
+}
+
+/// What else meets a caster's edge.
+#[derive(Debug, Clone, Copy)]
+enum Meeting {
+    Open,
+    /// One other edge between the same two points, and whether it runs the same way.
+    Pair(u32, bool),
+    /// Several: one of [`Casters::crowds`].
+    Crowd,
+}
+
+impl Casters {
+    /// `triangles` with their shared edges found (points that are equal
+    /// to the bit meet).
+    pub fn new(triangles: Vec<[Vec3; 3]>) -> Self {
+        let key = |v: Vec3| v.to_array().map(f32::to_bits);
+        // The directed edges between each two points.
+        // Hashed with Fx, not SipHash: the keys are the model's own points.
+        let mut meeting: FxHashMap<([u32; 3], [u32; 3]), Vec<u32>> = FxHashMap::default();
+        meeting.reserve(triangles.len() * 2);
+        for (t, triangle) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (p, q) = (key(triangle[k]), key(triangle[(k + 1) % 3]));
+                meeting.entry((p.min(q), p.max(q))).or_default().push((3 * t + k) as u32);
             }
         }
-    }
-    let caps = oriented.iter().flat_map(|t| t.map(|v| v.extend(1.0))).collect();
-    let mut sides = Vec::with_capacity(oriented.len() * 3);
-    for t in &oriented {
-        for (p, q) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-            if let Some(count) = open_edges.get_mut(&(key(p), key(q)))
-                && *count > 0
-            {
-                *count -= 1;
-                sides.extend([q.extend(1.0), p.extend(1.0), infinity]);
+        let mut meets = vec![Meeting::Open; triangles.len() * 3];
+        let mut crowds = Vec::new();
+        let start = |edge: u32| triangles[edge as usize / 3][edge as usize % 3];
+        for edges in meeting.into_values() {
+            match edges[..] {
+                [_] => {}
+                [first, second] => {
+                    let same = start(first) == start(second);
+                    meets[first as usize] = Meeting::Pair(second, same);
+                    meets[second as usize] = Meeting::Pair(first, same);
+                }
+                _ => {
+                    for &edge in &edges {
+                        meets[edge as usize] = Meeting::Crowd;
+                    }
+                    crowds.push(edges);
+                }
             }
         }
+        Self { triangles, meets, crowds }
     }
-    ShadowVolume { caps, sides }
+
+    /// The casters, as given.
+    pub fn triangles(&self) -> &[[Vec3; 3]] {
+        &self.triangles
+    }
+
+    /// The volume they shade from light arriving along `-to_light` (see
+    /// [`shadow_volume`]). Each caster is turned to face the light; two
+    /// edges between the same points that, turned, run opposite ways belong
+    /// to one shell and cast no side.
+    pub fn volume(&self, to_light: Vec3) -> ShadowVolume {
+        let infinity = (-to_light).extend(0.0);
+        // +1: the winding faces the light, −1: turned, 0: edge-on (no volume).
+        let facing: Vec<i8> = self
+            .triangles
+            .iter()
+            .map(|&[a, b, c]| {
+                let normal = (b - a).cross(c - a);
+                let facing = normal.dot(to_light);
+                if facing.abs() <= EDGE_ON * normal.length() { 0 } else { facing.signum() as i8 }
+            })
+            .collect();
+        // Where several edges meet, as many cancel each way as both ways have.
+        let mut cancelled_in_crowds = vec![false; if self.crowds.is_empty() { 0 } else { self.meets.len() }];
+        for edges in &self.crowds {
+            let reference = self.triangles[edges[0] as usize / 3][edges[0] as usize % 3];
+            let way = |edge: u32| {
+                let forward = self.triangles[edge as usize / 3][edge as usize % 3] == reference;
+                facing[edge as usize / 3] * if forward { 1 } else { -1 }
+            };
+            let (forward, backward): (Vec<u32>, Vec<u32>) = edges.iter().filter(|&&e| way(e) != 0).partition(|&&e| way(e) > 0);
+            for (&a, &b) in forward.iter().zip(&backward) {
+                cancelled_in_crowds[a as usize] = true;
+                cancelled_in_crowds[b as usize] = true;
+            }
+        }
+        let mut volume = ShadowVolume::default();
+        for (t, (&[a, b, c], &face)) in self.triangles.iter().zip(&facing).enumerate() {
+            if face == 0 {
+                continue;
+            }
+            let oriented = if face > 0 { [a, b, c] } else { [a, c, b] };
+            volume.caps.extend(oriented.map(|v| v.extend(1.0)));
+            for k in 0..3 {
+                let cancels = match self.meets[3 * t + k] {
+                    Meeting::Open => false,
+                    Meeting::Pair(other, same) => {
+                        let other_face = facing[other as usize / 3];
+                        other_face != 0 && if same { other_face != face } else { other_face == face }
+                    }
+                    Meeting::Crowd => cancelled_in_crowds[3 * t + k],
+                };
+                if !cancels {
+                    let (p, q) = (self.triangles[t][k], self.triangles[t][(k + 1) % 3]);
+                    let (p, q) = if face > 0 { (p, q) } else { (q, p) };
+                    volume.sides.extend([q.extend(1.0), p.extend(1.0), infinity]);
+                }
+            }
+        }
+        volume
+    }
 }
 
 #[cfg(test)]
 mod tests {
+    use std::collections::HashMap;
+
     use super::*;
 
     /// A closed surface: every directed edge meets its reverse equally often.

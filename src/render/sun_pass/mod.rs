@@ -42,7 +42,7 @@ use bevy::render::extract_component::{ExtractComponent, ExtractComponentPlugin};
 use bevy::render::extract_resource::{ExtractResource, ExtractResourcePlugin};
 use bevy::render::{Render, RenderApp, RenderStartup, RenderSystems};
 
-pub use heliodon_core::sun_pass::{DirectionPass, SunLight, SunPassFrame, lit_vertices};
+pub use heliodon_core::sun_pass::{DirectionPass, SunLight, SunPassFrame, SunPassSurfaces};
 
 pub struct SunPassPlugin;
 

@@ -45,7 +45,7 @@ pub(super) fn sun_pass(
     let depth_group =
         device.create_bind_group("heliodon_sun_depth", &layout(&pipelines.depth_layout), &BindGroupEntries::single(depth.view()));
 
-    let lit_vertices = (frame.lit.len() / 9) as u32;
+    let lit_vertices = (frame.surfaces.lit.len() / 9) as u32;
     let mut light_index = 0;
     for (pass_index, direction) in frame.passes.iter().enumerate() {
         // The first pass copies the main depth in; later ones keep that
@@ -84,28 +84,38 @@ pub(super) fn sun_pass(
                 }
             }};
         }
+        // The lit surfaces for one light: those its beam may reach, or all.
         macro_rules! draw_lit {
-            ($reference:expr) => {{
+            ($reference:expr, $share:expr) => {{
                 pass.set_pipeline(lit_pipeline);
                 pass.set_bind_group(0, &*view_group, &[view_offset.offset]);
                 pass.set_bind_group(1, &*light_group, &[buffers.light_offsets[light_index]]);
                 pass.set_stencil_reference($reference);
                 pass.set_vertex_buffer(0, *lit.slice(..));
-                pass.draw(0..lit_vertices, 0..1);
+                match ($share, &buffers.lit_indices) {
+                    (Some(range), Some(indices)) => {
+                        pass.set_index_buffer(*indices.slice(..), IndexFormat::Uint32);
+                        pass.draw_indexed(range.clone(), 0, 0..1);
+                    }
+                    (Some(_), None) => {}
+                    (None, _) => pass.draw(0..lit_vertices, 0..1),
+                }
             }};
         }
         draw_volumes!(count_caps, direction.opaque_caps.clone());
         draw_volumes!(count_volume, direction.opaque_sides.clone());
         for light in &direction.lights {
             match &light.aperture {
+                // A beam that reaches no lit surface draws nothing.
+                Some(_) if light.lit.as_ref().is_some_and(|share| share.is_empty()) => {}
                 Some(aperture) => {
                     draw_volumes!(toggle_volume, aperture.clone());
-                    draw_lit!(WINDOW_BIT);
+                    draw_lit!(WINDOW_BIT, light.lit.as_ref());
                     draw_volumes!(toggle_volume, aperture.clone());
                 }
                 None => {
                     draw_volumes!(count_volume, direction.all_windows.clone());
-                    draw_lit!(0);
+                    draw_lit!(0, light.lit.as_ref());
                 }
             }
             light_index += 1;

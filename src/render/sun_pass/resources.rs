@@ -14,7 +14,7 @@ use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::texture::{CachedTexture, TextureCache};
 use bevy::render::view::ViewUniform;
 
-use super::{DEPTH_COPY_SHADER, SUN_PASS_SHADER, SunPassFrame, SunPassInput, SunPassView};
+use super::{DEPTH_COPY_SHADER, SUN_PASS_SHADER, SunPassFrame, SunPassInput, SunPassSurfaces, SunPassView};
 
 /// Depth bias of the opaque casters' caps, away from the camera (reverse Z:
 /// negative), so the lit face of a caster, which is its volume's near cap,
@@ -47,8 +47,10 @@ pub(super) struct SunPassPipelines {
 #[derive(Resource, Default)]
 pub(super) struct SunPassBuffers {
     pub(super) generation: Option<u64>,
-    pub(super) lit: Option<(Arc<Vec<f32>>, Buffer)>,
+    pub(super) lit: Option<(Arc<SunPassSurfaces>, Buffer)>,
     pub(super) volumes: Option<Buffer>,
+    /// Each light's share of the lit surfaces ([`SunPassFrame::lit_indices`]).
+    pub(super) lit_indices: Option<Buffer>,
     pub(super) lights: DynamicUniformBuffer<SunLightUniform>,
     /// Dynamic offset of each light's uniform.
     pub(super) light_offsets: Vec<u32>,
@@ -192,16 +194,18 @@ pub(super) fn upload_frame(
         return;
     }
     let bytes = |floats: &[f32]| floats.iter().flat_map(|f| f.to_le_bytes()).collect::<Vec<u8>>();
-    let vertex_buffer = |label: &str, contents: &[u8]| {
-        (!contents.is_empty())
-            .then(|| device.create_buffer_with_data(&BufferInitDescriptor { label: Some(label), contents, usage: BufferUsages::VERTEX }))
+    let buffer = |label: &str, contents: &[u8], usage: BufferUsages| {
+        (!contents.is_empty()).then(|| device.create_buffer_with_data(&BufferInitDescriptor { label: Some(label), contents, usage }))
     };
-    let same_lit = buffers.lit.as_ref().is_some_and(|(data, _)| Arc::ptr_eq(data, &frame.lit));
+    let vertex_buffer = |label: &str, contents: &[u8]| buffer(label, contents, BufferUsages::VERTEX);
+    let same_lit = buffers.lit.as_ref().is_some_and(|(surfaces, _)| Arc::ptr_eq(surfaces, &frame.surfaces));
     if !same_lit {
-        buffers.lit = vertex_buffer("heliodon_sun_lit", &bytes(&frame.lit)).map(|b| (frame.lit.clone(), b));
+        buffers.lit = vertex_buffer("heliodon_sun_lit", &bytes(&frame.surfaces.lit)).map(|b| (frame.surfaces.clone(), b));
     }
     let volume_floats: Vec<f32> = frame.volumes.iter().flat_map(|v| v.to_array()).collect();
     buffers.volumes = vertex_buffer("heliodon_sun_volumes", &bytes(&volume_floats));
+    let indices: Vec<u8> = frame.lit_indices.iter().flat_map(|i| i.to_le_bytes()).collect();
+    buffers.lit_indices = buffer("heliodon_sun_lit_indices", &indices, BufferUsages::INDEX);
     buffers.lights.clear();
     let offsets: Vec<u32> =
         frame.lights().map(|l| buffers.lights.push(&SunLightUniform { direction: l.direction, irradiance: l.irradiance })).collect();
