@@ -17,13 +17,14 @@ use std::time::{Duration, SystemTime};
 use glam::DVec3;
 
 use super::gather::{Gather, SensorGeometry};
+use super::landings::Landings;
 use super::{LightModel, LightSettings};
 use crate::scene::{MaterialKind, Scene};
 use crate::sky::SkyPatches;
 
 const MAGIC: &[u8; 8] = b"HELIOLT\0";
 /// Bump when the model or its layout changes.
-const FORMAT: u32 = 10;
+const FORMAT: u32 = 11;
 
 /// What happened to the cache.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -458,6 +459,10 @@ fn check_payload((len, checksum): (u64, u64), read_len: u64, read_checksum: u64)
 pub(crate) struct Writer(pub Vec<u8>);
 
 impl Writer {
+    pub fn u16(&mut self, v: u16) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+
     pub fn u32(&mut self, v: u32) {
         self.0.extend_from_slice(&v.to_le_bytes());
     }
@@ -486,14 +491,31 @@ impl Writer {
     }
 
     /// Sparse rows sorted by index: each index as its step from the one
-    /// before (mostly one or two bytes), each share as it is (bit-exact).
+    /// before (mostly one or two bytes), each share bit-exact. A share that
+    /// is a whole number of the row's unit (2^-p: most are k rays of 2^p,
+    /// as 256 per patch side) is that number; others are the float as it is.
     pub fn pairs(&mut self, pairs: &[(u32, f32)]) {
         self.u32(pairs.len() as u32);
+        let bits = pairs.iter().filter_map(|&(_, w)| fraction_bits(w)).max().unwrap_or(0);
+        self.0.push(bits as u8);
+        let unit = (-(bits as f32)).exp2();
+        // Dividing by a power of two is exact: whole numbers of units stay whole.
+        let units = |w: f32| {
+            let units = w / unit;
+            (fraction_bits(w).is_some() && units < FRACTION_UNITS && (units as u32) as f32 * unit == w).then_some(units as u32)
+        };
         let mut previous = 0;
         for &(i, w) in pairs {
             self.varint(i - previous);
             previous = i;
-            self.f32(w);
+            match units(w) {
+                // Code k + 1: k units; 0: the float follows.
+                Some(k) => self.varint(k + 1),
+                None => {
+                    self.varint(0);
+                    self.f32(w);
+                }
+            }
         }
     }
 
@@ -501,6 +523,25 @@ impl Writer {
         self.pairs(&g.daylight_coefficients);
         self.pairs(&g.form_factors);
     }
+}
+
+/// The finest unit a row's shares are counted in, 2^-24.
+const MAX_FRACTION_BITS: u32 = 24;
+/// Whole numbers of units up to here are exact as floats.
+const FRACTION_UNITS: f32 = (1u32 << 24) as f32;
+
+/// The binary fraction digits `share` needs when it is a whole number of
+/// units of 2^-24 or coarser (a ray count over a power-of-two number of
+/// rays); `None` otherwise (light through glass, aimed rays).
+fn fraction_bits(share: f32) -> Option<u32> {
+    if !share.is_normal() || share < 0.0 {
+        return (share == 0.0 && share.is_sign_positive()).then_some(0);
+    }
+    let bits = share.to_bits();
+    let mantissa = (bits & 0x7f_ffff) | 0x80_0000;
+    let exponent = ((bits >> 23) & 0xff) as i32 - 127;
+    let fraction = (23 - mantissa.trailing_zeros() as i32 - exponent).max(0) as u32;
+    (fraction <= MAX_FRACTION_BITS).then_some(fraction)
 }
 
 /// Reader of the payload; `None` when it runs out.
@@ -514,6 +555,10 @@ impl Reader<'_> {
         let (head, tail) = self.0.split_at(n);
         self.0 = tail;
         Some(head)
+    }
+
+    pub fn u16(&mut self) -> Option<u16> {
+        self.take(2).map(|b| u16::from_le_bytes(b.try_into().expect("2 bytes")))
     }
 
     pub fn u32(&mut self) -> Option<u32> {
@@ -546,14 +591,20 @@ impl Reader<'_> {
 
     pub fn pairs(&mut self) -> Option<Vec<(u32, f32)>> {
         let n = self.u32()? as usize;
-        if n > self.0.len() / 5 {
+        let bits = *self.take(1)?.first()?;
+        if n > self.0.len() / 2 || u32::from(bits) > MAX_FRACTION_BITS {
             return None;
         }
+        let unit = (-f32::from(bits)).exp2();
         let mut previous: u32 = 0;
         (0..n)
             .map(|_| {
                 previous = previous.checked_add(self.varint()?)?;
-                Some((previous, self.f32()?))
+                let share = match self.varint()? {
+                    0 => self.f32()?,
+                    units => (units - 1) as f32 * unit,
+                };
+                Some((previous, share))
             })
             .collect()
     }
@@ -594,7 +645,7 @@ impl LightModel {
         let bins = (scene.windows.len() as u32 + 1) * 2 * SkyPatches::reinhart(settings.sky_subdivision).len() as u32;
         let patch_sides = sides as u32;
         let fits = |g: &Gather| g.daylight_coefficients.iter().all(|b| b.0 < bins) && g.form_factors.iter().all(|s| s.0 < patch_sides);
-        let hits_fit = |s: &SensorGeometry| s.hits.iter().all(|h| h.0 < patch_sides);
+        let hits_fit = |s: &SensorGeometry| s.landings.fits(patch_sides);
         if !r.is_empty() || !side_gathers.iter().all(fits) || !sensors.iter().all(|s| fits(&s.gather) && hits_fit(s)) {
             return None;
         }
@@ -611,12 +662,7 @@ impl SensorGeometry {
         self.sun_points.iter().for_each(|&p| w.vec3(p));
         w.vec3(self.normal);
         w.gather(&self.gather);
-        w.u32(self.hits.len() as u32);
-        for &(side, weight, point) in &self.hits {
-            w.u32(side);
-            w.f32(weight);
-            point.iter().for_each(|&c| w.f32(c));
-        }
+        self.landings.write(w);
     }
 
     pub(super) fn read(r: &mut Reader) -> Option<Self> {
@@ -625,15 +671,40 @@ impl SensorGeometry {
         let sun_points = (0..n).map(|_| r.vec3()).collect::<Option<Vec<_>>>()?;
         let normal = r.vec3()?;
         let gather = r.gather()?;
-        let n = count(r, 20)?;
-        let hits = (0..n).map(|_| Some((r.u32()?, r.f32()?, [r.f32()?, r.f32()?, r.f32()?]))).collect::<Option<Vec<_>>>()?;
-        Some(Self::new(gather, sun_points, normal, hits))
+        Some(Self::new(gather, sun_points, normal, Landings::read(r)?))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Rows read back bit for bit: shares counted in rays of a power of
+    /// two, others (through glass), zeros of both signs, tiny and large ones.
+    #[test]
+    fn sparse_rows_read_back_bit_for_bit() {
+        let rows: [&[(u32, f32)]; 4] = [
+            &[(0, 1.0 / 256.0), (3, 7.0 / 256.0), (9, 0.37 * 0.25), (700, 255.0 / 256.0)],
+            &[(2, 0.0), (5, -0.0), (6, f32::MIN_POSITIVE / 8.0), (40_000, 3.5), (40_001, 1.0 / 16384.0)],
+            &[(1, 0.3), (2, 0.7)],
+            &[],
+        ];
+        let mut w = Writer::default();
+        rows.iter().for_each(|row| w.pairs(row));
+        let compact = w.0.len();
+        let mut r = Reader(&w.0);
+        for row in rows {
+            let back = r.pairs().unwrap();
+            let bits = |row: &[(u32, f32)]| row.iter().map(|&(i, s)| (i, s.to_bits())).collect::<Vec<_>>();
+            assert_eq!(bits(&back), bits(row));
+        }
+        assert!(r.is_empty());
+        // A share of k rays takes one byte, not four.
+        let mut w = Writer::default();
+        w.pairs(&(0..100).map(|i| (i, (i % 50 + 1) as f32 / 256.0)).collect::<Vec<_>>());
+        assert_eq!(w.0.len(), 4 + 1 + 100 * 2);
+        assert!(compact < 4 * 4 + 4 + 11 * 5);
+    }
 
     /// The folder stays under its bound: least recently used files go
     /// first, never the one just written; stale temporary files go too.

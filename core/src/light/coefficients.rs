@@ -121,8 +121,8 @@ impl LightModel {
     /// Which sides some sensor's rays land on.
     fn sides_hit(&self) -> Vec<bool> {
         let mut hit = vec![false; self.side_gathers.len()];
-        for run in self.sensors.iter().flat_map(|sensor| sensor.hits_by_side()) {
-            hit[run[0].0 as usize] = true;
+        for (side, _, _) in self.sensors.iter().flat_map(|sensor| sensor.landings.by_side()) {
+            hit[side as usize] = true;
         }
         hit
     }

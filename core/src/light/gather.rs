@@ -13,6 +13,7 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use super::bvh::Tracer;
+use super::landings::Landings;
 use super::sampling::{self, Rng, cosine_directions, point_on_triangle};
 use super::{LightModel, LightSettings, MAX_GLASS_DEPTH, MIN_WEIGHT, SURFACE_OFFSET, Surface, par_map};
 use crate::scene::{Scene, Sensor};
@@ -198,28 +199,18 @@ pub(super) struct SensorGeometry {
     pub(super) sun_points: Vec<DVec3>,
     pub(super) normal: DVec3,
     pub(super) gather: Gather,
-    /// Where the sensor's rays meet patch sides, with their shares, sorted
-    /// by side: the sun's first bounce is evaluated at these points, not
-    /// averaged over patches (a sun patch right beside a sensor is what
-    /// patch averages get wrong).
-    pub(super) hits: Vec<(u32, f32, [f32; 3])>,
-    /// Where each side's run of `hits` ends.
-    run_ends: Vec<u32>,
+    /// Where the sensor's first rays meet patch sides the sun may reach,
+    /// with their shares: the sun's first bounce is evaluated at these
+    /// points, not averaged over patches (a sun patch right beside a sensor
+    /// is what patch averages get wrong).
+    pub(super) landings: Landings,
     /// The panels' window points it sees, per panel group, found on first use.
     pub(super) panel_views: std::sync::OnceLock<Vec<Vec<super::measured::SeenSample>>>,
 }
 
 impl SensorGeometry {
-    pub(super) fn new(gather: Gather, sun_points: Vec<DVec3>, normal: DVec3, mut hits: Vec<(u32, f32, [f32; 3])>) -> Self {
-        hits.sort_by_key(|h| h.0);
-        let run_ends = (1..=hits.len()).filter(|&k| k == hits.len() || hits[k].0 != hits[k - 1].0).map(|k| k as u32).collect();
-        Self { sun_points, normal, gather, hits, run_ends, panel_views: std::sync::OnceLock::new() }
-    }
-
-    /// The hits, a run per side.
-    pub(super) fn hits_by_side(&self) -> impl Iterator<Item = &[(u32, f32, [f32; 3])]> {
-        let starts = std::iter::once(0).chain(self.run_ends.iter().copied());
-        starts.zip(&self.run_ends).map(|(start, &end)| &self.hits[start as usize..end as usize])
+    pub(super) fn new(gather: Gather, sun_points: Vec<DVec3>, normal: DVec3, landings: Landings) -> Self {
+        Self { sun_points, normal, gather, landings, panel_views: std::sync::OnceLock::new() }
     }
 }
 
@@ -487,13 +478,11 @@ impl LightModel {
         // the sky is dark to the sun (as `openings` has it), and the landings
         // are most of a sensor's memory (none in a windowless room).
         let bounce_rays = trace(per_point, &mut coefficients, &mut hits);
-        let bounce: Vec<(u32, f32, [f32; 3])> = hits
-            .iter()
-            .filter(|h| self.may_be_sunlit(h.side))
-            .map(|h| (h.side, (h.weight / bounce_rays as f64) as f32, h.point.as_vec3().to_array()))
-            .collect();
+        let bounce =
+            hits.iter().filter(|h| self.may_be_sunlit(h.side)).map(|h| (h.side, (h.weight / bounce_rays as f64) as f32, h.point)).collect();
+        let landings = Landings::new(bounce, &self.patch_boxes);
         let rays = bounce_rays + trace(more_per_point, &mut coefficients, &mut hits);
-        SensorGeometry::new(Gather::from_raw(coefficients, &hits, rays), sun_points, normal, bounce)
+        SensorGeometry::new(Gather::from_raw(coefficients, &hits, rays), sun_points, normal, landings)
     }
 }
 

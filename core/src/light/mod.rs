@@ -35,6 +35,7 @@ pub mod coefficients;
 pub mod daylight;
 pub mod gather;
 mod glass;
+mod landings;
 mod lobe_table;
 mod measured;
 mod openings;
@@ -113,6 +114,8 @@ pub struct LightModel {
     panel_samples: Vec<measured::WindowSamples>,
     /// Where the sun can come in (spares shadow rays).
     openings: openings::Openings,
+    /// Per patch, the box its sensors' landings are stored in.
+    patch_boxes: Vec<landings::PatchBox>,
     /// Per patch side (2 per patch; empty for glass and the outer side of panels).
     side_gathers: Vec<Gather>,
     sensors: Vec<SensorGeometry>,
@@ -261,8 +264,15 @@ impl LightModel {
         for (k, window) in scene.windows.iter().enumerate() {
             window_of_surface[window.surface as usize] = Some(k as u32);
         }
+        let patch_boxes = scene
+            .patches
+            .patches
+            .iter()
+            .map(|patch| landings::PatchBox::around(&scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize]))
+            .collect();
         let mut model = Self {
             sky_bins: SkyPatches::reinhart(settings.sky_subdivision),
+            patch_boxes,
             windows,
             window_of_surface,
             panel_groups,

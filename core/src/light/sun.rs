@@ -186,16 +186,15 @@ impl LightModel {
     pub(super) fn sensor_sun_bounce(&self, index: usize, beams: &[SunBeam], reach: &[Reach]) -> [f64; 3] {
         let geometry = &self.sensors[index];
         let mut bounce = [0.0; 3];
-        for run in geometry.hits_by_side() {
-            let side = run[0].0;
+        for (side, shares, points) in geometry.landings.by_side() {
             let reach = &reach[side as usize];
             if *reach == Reach::None {
                 continue;
             }
             let Some(rho) = self.side_reflectance(side as usize) else { continue };
-            let normal = self.side_normal(side);
-            for &(_, share, point) in run {
-                let point = glam::Vec3::from_array(point).as_dvec3();
+            let (normal, patch_box) = (self.side_normal(side), &self.patch_boxes[side as usize / 2]);
+            for (&share, &grid) in shares.iter().zip(points) {
+                let point = patch_box.point(grid, normal);
                 let e = self.reaching_irradiance(reach, point, normal, beams);
                 if e > 0.0 {
                     for (b, r) in bounce.iter_mut().zip(rho) {
