@@ -23,7 +23,7 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3, Vec4};
 
-pub use shadow_volume::{Casters, ShadowVolume, shadow_volume};
+pub use shadow_volume::{Casters, ShadowVolume, VolumeEnd, shadow_volume};
 
 use crate::light::{Glass, LightModel};
 use crate::scene::{MaterialKind, Scene, clip_convex};
@@ -116,8 +116,11 @@ impl SunPassFrame {
             volumes.extend(volume.sides);
             (caps.clone(), caps.end..volumes.len() as u32)
         };
-        let add_volume =
-            |casters: &[[Vec3; 3]], direction: Vec3, volumes: &mut Vec<Vec4>| append(shadow_volume(casters, direction), volumes);
+        // Volumes end a metre past the ground drawn outside (or above the model, for light going up).
+        let end = |direction: Vec3| VolumeEnd::beyond(GroundPlane::of(scene).height, scene.bounds.1.z, direction);
+        let add_volume = |casters: &[[Vec3; 3]], direction: Vec3, volumes: &mut Vec<Vec4>| {
+            append(shadow_volume(casters, direction, end(direction)), volumes)
+        };
         let direction_pass = |(opaque_caps, opaque_sides): (Range<u32>, Range<u32>)| DirectionPass {
             opaque_caps,
             opaque_sides,
@@ -127,7 +130,7 @@ impl SunPassFrame {
         let runs = &surfaces.runs;
         let mut lit_indices = Vec::new();
         let to_sun = sun.direction.as_vec3();
-        let mut sun_pass = direction_pass(append(surfaces.opaque.volume(to_sun), &mut volumes));
+        let mut sun_pass = direction_pass(append(surfaces.opaque.volume(to_sun, end(to_sun)), &mut volumes));
         let windows_start = volumes.len() as u32;
         let mut aperture_volumes = Vec::new();
         for (_, panes, _) in &apertures {
@@ -161,7 +164,7 @@ impl SunPassFrame {
                     let inner_casters = Casters::new(beside(opaque_casters, panes[0][0], inside));
                     for beam in beams.iter().filter(|b| b.panel_group == Some(*group)) {
                         let direction = beam.to_light.as_vec3();
-                        let mut pass = direction_pass(append(inner_casters.volume(direction), &mut volumes));
+                        let mut pass = direction_pass(append(inner_casters.volume(direction, end(direction)), &mut volumes));
                         let (_, shadow_sides) = add_volume(&shadows, direction, &mut volumes);
                         pass.opaque_sides.end = shadow_sides.end;
                         let (caps, sides) = add_volume(panes, direction, &mut volumes);

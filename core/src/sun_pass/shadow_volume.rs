@@ -3,9 +3,11 @@
 //! Plain geometry, no Bevy types.
 //!
 //! Each caster triangle, turned to face the light, bounds the volume of
-//! space it shades: its own face (the near cap) and one side triangle per
-//! edge, reaching the point at infinity away from the light (for a
-//! directional light the far cap shrinks to that point). Where two casters
+//! space it shades: its own face (the near cap) and one side per edge,
+//! reaching away from the light to where the volume ends ([`VolumeEnd`]):
+//! the point at infinity (for a directional light the far cap shrinks to
+//! that point), or a plane beyond every receiver, where the far cap is the
+//! face projected along the light. Where two casters
 //! share an edge with opposite directions, as in a manifold mesh, their side
 //! triangles coincide with opposite windings and cancel: both are left out,
 //! so only silhouette and open edges get sides. Elsewhere (open meshes,
@@ -20,14 +22,42 @@ use rustc_hash::FxHashMap;
 const EDGE_ON: f32 = 1e-6;
 
 /// A closed shadow volume as triangles: the casters' faces (near caps) and
-/// the sides from their silhouette and open edges to infinity.
+/// the sides from their silhouette and open edges to where the volume ends.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ShadowVolume {
     /// The casters' own faces, turned to face the light (the near caps).
     pub caps: Vec<Vec4>,
-    /// One triangle per silhouette or open edge: its two ends and the point
-    /// at infinity away from the light (w = 0).
+    /// Per silhouette or open edge, its side: one triangle to the point at
+    /// infinity away from the light (w = 0), or a quad down to the plane the
+    /// volume ends on; then, for such a plane, the casters' far caps there.
     pub sides: Vec<Vec4>,
+}
+
+/// Where volumes end away from the light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum VolumeEnd {
+    /// At infinity: every side a triangle to the point at infinity.
+    Infinity,
+    /// On the horizontal plane at this height, beyond everything that
+    /// receives light: sides and far caps cover far less of the screen than
+    /// sides to infinity (rasterizing them is most of a frame of a model
+    /// with many casters).
+    Plane(f32),
+}
+
+impl VolumeEnd {
+    /// The plane beyond every receiver at heights `low..high` (the ground
+    /// drawn outside included) for light along `-to_light`: a metre below
+    /// for light going down, above for light going up; infinity for light
+    /// within 3° of level, whose volumes would reach almost as far.
+    pub fn beyond(low: f32, high: f32, to_light: Vec3) -> Self {
+        const LEVEL: f32 = 0.05;
+        match to_light.z {
+            z if z > LEVEL => Self::Plane(low - 1.0),
+            z if z < -LEVEL => Self::Plane(high + 1.0),
+            _ => Self::Infinity,
+        }
+    }
 }
 
 /// The volume shaded by `casters` from light arriving along `-to_light`
@@ -35,8 +65,8 @@ pub struct ShadowVolume {
 /// its volume's near cap: the stencil pass biases the caps, and only them,
 /// away from the camera so that face counts as outside; biased sides would
 /// move the shadow's edges.
-pub fn shadow_volume(casters: &[[Vec3; 3]], to_light: Vec3) -> ShadowVolume {
-    Casters::new(casters.to_vec()).volume(to_light)
+pub fn shadow_volume(casters: &[[Vec3; 3]], to_light: Vec3, end: VolumeEnd) -> ShadowVolume {
+    Casters::new(casters.to_vec()).volume(to_light, end)
 }
 
 /// Casters with their shared edges found once: which edges meet does not
@@ -107,8 +137,13 @@ impl Casters {
     /// [`shadow_volume`]). Each caster is turned to face the light; two
     /// edges between the same points that, turned, run opposite ways belong
     /// to one shell and cast no side.
-    pub fn volume(&self, to_light: Vec3) -> ShadowVolume {
-        let infinity = (-to_light).extend(0.0);
+    pub fn volume(&self, to_light: Vec3, end: VolumeEnd) -> ShadowVolume {
+        // Where a point's shadow ends (every caster lies on the light's side of the plane).
+        let far = |p: Vec3| match end {
+            VolumeEnd::Infinity => (-to_light).extend(0.0),
+            VolumeEnd::Plane(z) => (p - to_light * ((p.z - z) / to_light.z)).extend(1.0),
+        };
+        let mut far_caps = Vec::new();
         // +1: the winding faces the light, −1: turned, 0: edge-on (no volume).
         let facing: Vec<i8> = self
             .triangles
@@ -140,6 +175,10 @@ impl Casters {
             }
             let oriented = if face > 0 { [a, b, c] } else { [a, c, b] };
             volume.caps.extend(oriented.map(|v| v.extend(1.0)));
+            if end != VolumeEnd::Infinity {
+                let [a, b, c] = oriented;
+                far_caps.extend([far(a), far(c), far(b)]);
+            }
             for k in 0..3 {
                 let cancels = match self.meets[3 * t + k] {
                     Meeting::Open => false,
@@ -152,10 +191,14 @@ impl Casters {
                 if !cancels {
                     let (p, q) = (self.triangles[t][k], self.triangles[t][(k + 1) % 3]);
                     let (p, q) = if face > 0 { (p, q) } else { (q, p) };
-                    volume.sides.extend([q.extend(1.0), p.extend(1.0), infinity]);
+                    match end {
+                        VolumeEnd::Infinity => volume.sides.extend([q.extend(1.0), p.extend(1.0), far(p)]),
+                        VolumeEnd::Plane(_) => volume.sides.extend([q.extend(1.0), p.extend(1.0), far(p), q.extend(1.0), far(p), far(q)]),
+                    }
                 }
             }
         }
+        volume.sides.extend(far_caps);
         volume
     }
 }
@@ -196,11 +239,27 @@ mod tests {
     #[test]
     fn a_manifold_cube_gets_sides_only_on_its_silhouette() {
         let light = Vec3::new(0.3, -0.4, 0.866).normalize();
-        let volume = shadow_volume(&cube(), light);
+        let volume = shadow_volume(&cube(), light, VolumeEnd::Infinity);
         assert!(is_closed(&volume));
         // Faces turned to the light: all 12 triangles (back faces flipped);
         // each of the two shells keeps only its 6 silhouette edges.
         assert_eq!((volume.caps.len() / 3, volume.sides.len() / 3), (12, 12));
+    }
+
+    /// Ending on a plane below: the volume is still closed, the silhouette's
+    /// sides are quads down to the plane, and every caster gets a far cap there.
+    #[test]
+    fn volumes_ending_on_a_plane_are_closed_and_stop_there() {
+        let light = Vec3::new(0.3, -0.4, 0.866).normalize();
+        let volume = shadow_volume(&cube(), light, VolumeEnd::Plane(-2.0));
+        assert!(is_closed(&volume));
+        assert_eq!((volume.caps.len() / 3, volume.sides.len() / 3), (12, 12 * 2 + 12));
+        assert!(volume.caps.iter().chain(&volume.sides).all(|v| v.w == 1.0 && (-2.0 - 1e-5..=1.0).contains(&v.z)));
+        let on_the_plane = volume.sides.iter().filter(|v| (v.z + 2.0).abs() < 1e-5).count();
+        assert_eq!(on_the_plane, 12 * 3 + 12 * 3, "the far corners of each side's two triangles, and the far caps");
+        assert_eq!(VolumeEnd::beyond(0.0, 9.0, light), VolumeEnd::Plane(-1.0));
+        assert_eq!(VolumeEnd::beyond(0.0, 9.0, -light), VolumeEnd::Plane(10.0));
+        assert_eq!(VolumeEnd::beyond(0.0, 9.0, Vec3::X), VolumeEnd::Infinity);
     }
 
     #[test]
@@ -212,17 +271,21 @@ mod tests {
         let (a, b, c) = (Vec3::new(2., 0., 0.), Vec3::new(4., 0., 0.), Vec3::new(3., 1., 0.));
         let m = Vec3::new(3., 0., 0.);
         casters.extend([[a, b, c], [b, a, Vec3::new(2.5, -1., 0.)], [m, a, Vec3::new(3., -1., 0.)]]);
-        let volume = shadow_volume(&casters, Vec3::new(0.2, 0.1, 1.0).normalize());
+        let volume = shadow_volume(&casters, Vec3::new(0.2, 0.1, 1.0).normalize(), VolumeEnd::Infinity);
         assert!(is_closed(&volume));
     }
 
     #[test]
     fn edge_on_casters_cast_nothing() {
         let wall = [[Vec3::ZERO, Vec3::X, Vec3::Z]];
-        assert_eq!(shadow_volume(&wall, Vec3::Y).caps.len(), 3);
-        assert_eq!(shadow_volume(&wall, Vec3::Z), ShadowVolume::default(), "a wall edge-on to the light casts nothing");
+        assert_eq!(shadow_volume(&wall, Vec3::Y, VolumeEnd::Infinity).caps.len(), 3);
+        assert_eq!(
+            shadow_volume(&wall, Vec3::Z, VolumeEnd::Infinity),
+            ShadowVolume::default(),
+            "a wall edge-on to the light casts nothing"
+        );
         let floor = [[Vec3::ZERO, Vec3::X, Vec3::Y]];
-        let volume = shadow_volume(&floor, Vec3::Z);
+        let volume = shadow_volume(&floor, Vec3::Z, VolumeEnd::Infinity);
         assert!(volume.caps.iter().all(|v| v.z == 0.0 && v.w == 1.0));
         assert!(volume.sides.chunks(3).all(|t| t[2] == Vec4::new(0., 0., -1., 0.)));
     }
