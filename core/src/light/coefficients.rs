@@ -411,13 +411,7 @@ impl SensorCoefficients {
                 None => seen.sky_irradiance(&geometry.gather) * LUMINOUS_EFFICACY,
                 Some(beside) => f64::from(beside.direct[i]) + seen.sky_irradiance_through(&geometry.gather, read_here) * LUMINOUS_EFFICACY,
             };
-            SensorReading {
-                name: model.scene.sensors[i].name.clone(),
-                total: direct_sun + direct_sky + indirect[i],
-                direct_sun,
-                direct_sky,
-                indirect: indirect[i],
-            }
+            SensorReading::new(model.scene.sensors[i].name.clone(), direct_sun, direct_sky, indirect[i])
         })
     }
 

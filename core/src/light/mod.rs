@@ -166,6 +166,15 @@ pub struct SensorReading {
     pub indirect: f64,
 }
 
+impl SensorReading {
+    /// A reading from its three parts (lux). A part that is an empty sum
+    /// reads 0, not −0 (Rust sums floats from −0).
+    pub fn new(name: String, direct_sun: f64, direct_sky: f64, indirect: f64) -> Self {
+        let (direct_sun, direct_sky, indirect) = (direct_sun + 0.0, direct_sky + 0.0, indirect + 0.0);
+        Self { name, total: direct_sun + direct_sky + indirect, direct_sun, direct_sky, indirect }
+    }
+}
+
 /// The light for one sun and sky.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Lighting {
@@ -431,5 +440,21 @@ impl LightModel {
                 })
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sensor no sun or sky reaches says 0 lux of each, not −0 (an empty
+    /// sum of floats is −0 in Rust).
+    #[test]
+    fn a_dark_sensor_reads_zero_not_minus_zero() {
+        let nothing: f64 = std::iter::empty::<f64>().sum();
+        assert!(nothing.is_sign_negative());
+        let reading = SensorReading::new("dark".into(), nothing, nothing * crate::sky::LUMINOUS_EFFICACY, 0.0);
+        let shown = format!("{:.1} {:.1} {:.1} {:.1}", reading.total, reading.direct_sun, reading.direct_sky, reading.indirect);
+        assert_eq!(shown, "0.0 0.0 0.0 0.0");
     }
 }

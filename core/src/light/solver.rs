@@ -220,13 +220,7 @@ impl Relight<'_> {
                 let rgb = form_factor_product(direct.sun_bounce, &geometry.gather.form_factors, &without_sun);
                 let indirect = Channels { indirect: rgb, ..Default::default() }.indirect_luminous();
                 let lux = |e: f64| e * LUMINOUS_EFFICACY;
-                SensorReading {
-                    name: sensor.name.clone(),
-                    total: lux(direct.sun + direct.sky + indirect),
-                    direct_sun: lux(direct.sun),
-                    direct_sky: lux(direct.sky),
-                    indirect: lux(indirect),
-                }
+                SensorReading::new(sensor.name.clone(), lux(direct.sun), lux(direct.sky), lux(indirect))
             })
             .collect();
         Lighting { sides, sensors, iterations: self.solver.iterations, residual: self.solver.residual }
