@@ -656,6 +656,60 @@ impl LightModel {
     }
 }
 
+impl Landings {
+    /// Each run as its side's step from the last and its length; the
+    /// shares run-length coded (most are 1/rays); the points as they are.
+    fn write(&self, w: &mut Writer) {
+        let (runs, shares, points) = self.parts();
+        w.u32(runs.len() as u32);
+        let (mut side, mut end) = (0, 0);
+        for &(s, e) in runs {
+            w.varint(s - side);
+            w.varint(e - end);
+            (side, end) = (s, e);
+        }
+        let mut repeats: Vec<(u32, f32)> = Vec::new();
+        for &share in shares {
+            match repeats.last_mut() {
+                Some((count, value)) if value.to_bits() == share.to_bits() => *count += 1,
+                _ => repeats.push((1, share)),
+            }
+        }
+        w.u32(repeats.len() as u32);
+        for (count, value) in repeats {
+            w.varint(count);
+            w.f32(value);
+        }
+        points.iter().flatten().for_each(|&c| w.u16(c));
+    }
+
+    fn read(r: &mut Reader) -> Option<Self> {
+        let count = |r: &mut Reader, least_bytes: usize| r.u32().map(|n| n as usize).filter(|&n| n <= r.0.len() / least_bytes);
+        let (mut side, mut end) = (0u32, 0u32);
+        let runs = (0..count(r, 2)?)
+            .map(|_| {
+                side = side.checked_add(r.varint()?)?;
+                end = end.checked_add(r.varint()?)?;
+                Some((side, end))
+            })
+            .collect::<Option<Vec<_>>>()?;
+        let total = end as usize;
+        let mut shares = Vec::with_capacity(total.min(r.0.len() / 6));
+        for _ in 0..count(r, 5)? {
+            let (repeat, value) = (r.varint()? as usize, r.f32()?);
+            if shares.len() + repeat > total {
+                return None;
+            }
+            shares.extend(std::iter::repeat_n(value, repeat));
+        }
+        if shares.len() != total || r.0.len() < total * 6 {
+            return None;
+        }
+        let points = (0..total).map(|_| Some([r.u16()?, r.u16()?, r.u16()?])).collect::<Option<Vec<_>>>()?;
+        Self::from_parts(runs, shares, points)
+    }
+}
+
 impl SensorGeometry {
     pub(super) fn write(&self, w: &mut Writer) {
         w.u32(self.sun_points.len() as u32);
@@ -678,6 +732,25 @@ impl SensorGeometry {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A sensor's landings read back as written; a cut payload is refused.
+    #[test]
+    fn landings_are_read_back_as_written() {
+        use super::super::landings::PatchBox;
+        let boxes = vec![PatchBox::around(&[[glam::Vec3::ZERO, glam::Vec3::X, glam::Vec3::Y]]); 4];
+        let p = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        let raw = vec![(5, 0.5, p(0.1, 0.2)), (1, 0.25, p(0.3, 0.3)), (5, 0.5, p(0.9, 0.05)), (2, 0.125, p(0.0, 1.0))];
+        let landings = Landings::new(raw, &boxes);
+        let sides: Vec<(u32, usize)> = landings.by_side().map(|(side, shares, _)| (side, shares.len())).collect();
+        assert_eq!(sides, [(1, 1), (2, 1), (5, 2)]);
+        let mut w = Writer::default();
+        landings.write(&mut w);
+        let mut r = Reader(&w.0);
+        assert_eq!(Landings::read(&mut r), Some(landings.clone()));
+        assert!(r.is_empty());
+        assert!(Landings::read(&mut Reader(&w.0[..w.0.len() - 1])).is_none(), "a cut payload is refused");
+        assert!(landings.fits(6) && !landings.fits(5));
+    }
 
     /// Rows read back bit for bit: shares counted in rays of a power of
     /// two, others (through glass), zeros of both signs, tiny and large ones.

@@ -10,8 +10,6 @@
 
 use glam::{DVec3, Vec3};
 
-use super::cache::{Reader, Writer};
-
 /// A patch's bounding box, where its landings are stored in 16 bits per axis
 /// (a 4 m patch to 0.06 mm).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,11 +44,13 @@ impl PatchBox {
     }
 }
 
+/// A run of landings: its side and where its landings end.
+pub(super) type Run = (u32, u32);
+
 /// A sensor's landings on patch sides, a run per side in side order.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub(super) struct Landings {
-    /// Each run's side and where its landings end.
-    runs: Vec<(u32, u32)>,
+    runs: Vec<Run>,
     /// Each landing's share of the sensor's irradiance (the ray's weight
     /// over the rays traced).
     shares: Vec<f32>,
@@ -63,7 +63,7 @@ impl Landings {
     /// (per patch; a side's patch is `side / 2`).
     pub(super) fn new(mut landings: Vec<(u32, f32, DVec3)>, boxes: &[PatchBox]) -> Self {
         landings.sort_by_key(|l| l.0);
-        let mut runs: Vec<(u32, u32)> = Vec::new();
+        let mut runs: Vec<Run> = Vec::new();
         for (k, &(side, _, _)) in landings.iter().enumerate() {
             match runs.last_mut() {
                 Some(run) if run.0 == side => run.1 = k as u32 + 1,
@@ -89,56 +89,18 @@ impl Landings {
         self.runs.iter().all(|r| r.0 < sides)
     }
 
-    /// For the cache: each run as its side's step from the last and its
-    /// length; the shares run-length coded (most are 1/rays); the points
-    /// as they are.
-    pub(super) fn write(&self, w: &mut Writer) {
-        w.u32(self.runs.len() as u32);
-        let (mut side, mut end) = (0, 0);
-        for &(s, e) in &self.runs {
-            w.varint(s - side);
-            w.varint(e - end);
-            (side, end) = (s, e);
-        }
-        let mut repeats: Vec<(u32, f32)> = Vec::new();
-        for &share in &self.shares {
-            match repeats.last_mut() {
-                Some((count, value)) if value.to_bits() == share.to_bits() => *count += 1,
-                _ => repeats.push((1, share)),
-            }
-        }
-        w.u32(repeats.len() as u32);
-        for (count, value) in repeats {
-            w.varint(count);
-            w.f32(value);
-        }
-        self.points.iter().flatten().for_each(|&c| w.u16(c));
+    /// Its runs (each side and where its landings end), shares and grid
+    /// points, as the cache stores them.
+    pub(super) fn parts(&self) -> (&[Run], &[f32], &[[u16; 3]]) {
+        (&self.runs, &self.shares, &self.points)
     }
 
-    pub(super) fn read(r: &mut Reader) -> Option<Self> {
-        let count = |r: &mut Reader, least_bytes: usize| r.u32().map(|n| n as usize).filter(|&n| n <= r.0.len() / least_bytes);
-        let (mut side, mut end) = (0u32, 0u32);
-        let runs = (0..count(r, 2)?)
-            .map(|_| {
-                side = side.checked_add(r.varint()?)?;
-                end = end.checked_add(r.varint()?)?;
-                Some((side, end))
-            })
-            .collect::<Option<Vec<_>>>()?;
-        let total = end as usize;
-        let mut shares = Vec::with_capacity(total.min(r.0.len() / 6));
-        for _ in 0..count(r, 5)? {
-            let (repeat, value) = (r.varint()? as usize, r.f32()?);
-            if shares.len() + repeat > total {
-                return None;
-            }
-            shares.extend(std::iter::repeat_n(value, repeat));
-        }
-        if shares.len() != total || r.0.len() < total * 6 {
-            return None;
-        }
-        let points = (0..total).map(|_| Some([r.u16()?, r.u16()?, r.u16()?])).collect::<Option<Vec<_>>>()?;
-        Some(Self { runs, shares, points })
+    /// Landings from their parts; `None` unless the runs go up by side and
+    /// end, the last at the shares' and points' count.
+    pub(super) fn from_parts(runs: Vec<Run>, shares: Vec<f32>, points: Vec<[u16; 3]>) -> Option<Self> {
+        let ordered = runs.windows(2).all(|w| w[0].0 < w[1].0 && w[0].1 < w[1].1) && runs.first().is_none_or(|r| r.1 > 0);
+        let complete = runs.last().map_or(0, |r| r.1 as usize) == shares.len() && shares.len() == points.len();
+        (ordered && complete).then_some(Self { runs, shares, points })
     }
 }
 
@@ -164,23 +126,5 @@ mod tests {
             assert!(above > 0.0 && above < 2e-4, "{above}");
             assert!((back - point).length() < 2e-4);
         }
-    }
-
-    /// Runs by side in side order, and the cache's form reads back the same.
-    #[test]
-    fn landings_are_read_back_as_written() {
-        let boxes = vec![PatchBox::around(&[[Vec3::ZERO, Vec3::X, Vec3::Y]]); 4];
-        let p = |x: f64, y: f64| DVec3::new(x, y, 0.0);
-        let raw = vec![(5, 0.5, p(0.1, 0.2)), (1, 0.25, p(0.3, 0.3)), (5, 0.5, p(0.9, 0.05)), (2, 0.125, p(0.0, 1.0))];
-        let landings = Landings::new(raw, &boxes);
-        let sides: Vec<(u32, usize)> = landings.by_side().map(|(side, shares, _)| (side, shares.len())).collect();
-        assert_eq!(sides, [(1, 1), (2, 1), (5, 2)]);
-        let mut w = Writer::default();
-        landings.write(&mut w);
-        let mut r = Reader(&w.0);
-        assert_eq!(Landings::read(&mut r), Some(landings.clone()));
-        assert!(r.0.is_empty());
-        assert!(Landings::read(&mut Reader(&w.0[..w.0.len() - 1])).is_none(), "a cut payload is refused");
-        assert!(landings.fits(6) && !landings.fits(5));
     }
 }
