@@ -93,13 +93,13 @@ impl SunPassFrame {
             Glass(u32),
             Panel(u32),
         }
-        let apertures: Vec<(Key, Vec<[Vec3; 3]>, Vec3)> = model
+        let apertures: Vec<(Key, Casters, Vec3)> = model
             .windows
             .groups
             .iter()
             .map(|group| {
                 let surfaces = group.windows.iter().map(|&w| scene.windows[w as usize].surface);
-                let panes = surfaces.clone().flat_map(surface_triangles).collect();
+                let panes = Casters::new(surfaces.clone().flat_map(surface_triangles).collect());
                 let first = surfaces.clone().next().expect("a group has a window");
                 let key = match model.panel_group_of_surface(first) {
                     Some(panel_group) => Key::Panel(panel_group),
@@ -109,18 +109,10 @@ impl SunPassFrame {
             })
             .collect();
         let mut volumes: Vec<Vec4> = Vec::new();
-        let append = |volume: ShadowVolume, volumes: &mut Vec<Vec4>| {
-            let start = volumes.len() as u32;
-            let caps = start..start + volume.caps.len() as u32;
-            volumes.extend(volume.caps);
-            volumes.extend(volume.sides);
-            (caps.clone(), caps.end..volumes.len() as u32)
-        };
         // Volumes end a metre past the ground drawn outside (or above the model, for light going up).
         let end = |direction: Vec3| VolumeEnd::beyond(GroundPlane::of(scene).height, scene.bounds.1.z, direction);
-        let add_volume = |casters: &[[Vec3; 3]], direction: Vec3, volumes: &mut Vec<Vec4>| {
-            append(shadow_volume(casters, direction, end(direction)), volumes)
-        };
+        let add_volume =
+            |casters: &Casters, direction: Vec3, volumes: &mut Vec<Vec4>| casters.volume_into(direction, end(direction), volumes);
         let direction_pass = |(opaque_caps, opaque_sides): (Range<u32>, Range<u32>)| DirectionPass {
             opaque_caps,
             opaque_sides,
@@ -130,7 +122,7 @@ impl SunPassFrame {
         let runs = &surfaces.runs;
         let mut lit_indices = Vec::new();
         let to_sun = sun.direction.as_vec3();
-        let mut sun_pass = direction_pass(append(surfaces.opaque.volume(to_sun, end(to_sun)), &mut volumes));
+        let mut sun_pass = direction_pass(add_volume(&surfaces.opaque, to_sun, &mut volumes));
         let windows_start = volumes.len() as u32;
         let mut aperture_volumes = Vec::new();
         for (_, panes, _) in &apertures {
@@ -140,7 +132,8 @@ impl SunPassFrame {
         sun_pass.all_windows = windows_start..volumes.len() as u32;
         let beams = model.sun_beams(sun);
         let mut lobe_passes = Vec::new();
-        for ((key, panes, normal), volume) in apertures.iter().zip(aperture_volumes) {
+        for ((key, pane_casters, normal), volume) in apertures.iter().zip(aperture_volumes) {
+            let panes = pane_casters.triangles();
             match key {
                 Key::Glass(material) => {
                     let cos = f64::from(normal.dot(to_sun));
@@ -157,17 +150,17 @@ impl SunPassFrame {
                 Key::Panel(group) => {
                     // What shades the panel from the real sun outside casts
                     // along each lobe too, from where it lies on the panel.
-                    let shadows = shadows_on(panes, *normal, opaque_casters, to_sun);
+                    let shadows = Casters::new(shadows_on(panes, *normal, opaque_casters, to_sun));
                     // A lobe's light starts at the panel: only what lies on
                     // the room side of it casts along the lobe.
                     let inside = normal * -to_sun.dot(*normal).signum();
                     let inner_casters = Casters::new(beside(opaque_casters, panes[0][0], inside));
                     for beam in beams.iter().filter(|b| b.panel_group == Some(*group)) {
                         let direction = beam.to_light.as_vec3();
-                        let mut pass = direction_pass(append(inner_casters.volume(direction, end(direction)), &mut volumes));
+                        let mut pass = direction_pass(add_volume(&inner_casters, direction, &mut volumes));
                         let (_, shadow_sides) = add_volume(&shadows, direction, &mut volumes);
                         pass.opaque_sides.end = shadow_sides.end;
-                        let (caps, sides) = add_volume(panes, direction, &mut volumes);
+                        let (caps, sides) = add_volume(pane_casters, direction, &mut volumes);
                         pass.lights.push(SunLight {
                             direction,
                             irradiance: beam.normal_irradiance as f32,

@@ -14,6 +14,8 @@
 //! T-junctions, duplicated faces) every triangle keeps its own closed volume,
 //! so the stencil count stays exact whatever the model's quality.
 
+use std::ops::Range;
+
 use glam::{Vec3, Vec4};
 use rustc_hash::FxHashMap;
 
@@ -134,16 +136,26 @@ impl Casters {
     }
 
     /// The volume they shade from light arriving along `-to_light` (see
-    /// [`shadow_volume`]). Each caster is turned to face the light; two
+    /// [`shadow_volume`]).
+    pub fn volume(&self, to_light: Vec3, end: VolumeEnd) -> ShadowVolume {
+        let mut caps = Vec::new();
+        let (near, _) = self.volume_into(to_light, end, &mut caps);
+        let sides = caps.split_off(near.end as usize);
+        ShadowVolume { caps, sides }
+    }
+
+    /// Appends the volume to `out` (a large model's is tens of megabytes,
+    /// made again each sun move, so it is written once, in place): the near
+    /// caps, then the sides and the far caps. Returns the caps' range there
+    /// and that of the rest. Each caster is turned to face the light; two
     /// edges between the same points that, turned, run opposite ways belong
     /// to one shell and cast no side.
-    pub fn volume(&self, to_light: Vec3, end: VolumeEnd) -> ShadowVolume {
+    pub fn volume_into(&self, to_light: Vec3, end: VolumeEnd, out: &mut Vec<Vec4>) -> (Range<u32>, Range<u32>) {
         // Where a point's shadow ends (every caster lies on the light's side of the plane).
         let far = |p: Vec3| match end {
             VolumeEnd::Infinity => (-to_light).extend(0.0),
             VolumeEnd::Plane(z) => (p - to_light * ((p.z - z) / to_light.z)).extend(1.0),
         };
-        let mut far_caps = Vec::new();
         // +1: the winding faces the light, −1: turned, 0: edge-on (no volume).
         let facing: Vec<i8> = self
             .triangles
@@ -168,38 +180,46 @@ impl Casters {
                 cancelled_in_crowds[b as usize] = true;
             }
         }
-        let mut volume = ShadowVolume::default();
-        for (t, (&[a, b, c], &face)) in self.triangles.iter().zip(&facing).enumerate() {
-            if face == 0 {
-                continue;
+        let casts_side = |edge: usize| match self.meets[edge] {
+            Meeting::Open => true,
+            Meeting::Pair(other, same) => {
+                let (face, other_face) = (facing[edge / 3], facing[other as usize / 3]);
+                other_face == 0 || if same { other_face == face } else { other_face != face }
             }
-            let oriented = if face > 0 { [a, b, c] } else { [a, c, b] };
-            volume.caps.extend(oriented.map(|v| v.extend(1.0)));
-            if end != VolumeEnd::Infinity {
-                let [a, b, c] = oriented;
-                far_caps.extend([far(a), far(c), far(b)]);
-            }
-            for k in 0..3 {
-                let cancels = match self.meets[3 * t + k] {
-                    Meeting::Open => false,
-                    Meeting::Pair(other, same) => {
-                        let other_face = facing[other as usize / 3];
-                        other_face != 0 && if same { other_face != face } else { other_face == face }
-                    }
-                    Meeting::Crowd => cancelled_in_crowds[3 * t + k],
-                };
-                if !cancels {
-                    let (p, q) = (self.triangles[t][k], self.triangles[t][(k + 1) % 3]);
-                    let (p, q) = if face > 0 { (p, q) } else { (q, p) };
-                    match end {
-                        VolumeEnd::Infinity => volume.sides.extend([q.extend(1.0), p.extend(1.0), far(p)]),
-                        VolumeEnd::Plane(_) => volume.sides.extend([q.extend(1.0), p.extend(1.0), far(p), q.extend(1.0), far(p), far(q)]),
-                    }
+            Meeting::Crowd => !cancelled_in_crowds[edge],
+        };
+        // Each caster turned to face the light, and its edges (start, end) so turned.
+        let casting = || facing.iter().enumerate().filter(|(_, f)| **f != 0);
+        let turned = |t: usize| {
+            let [a, b, c] = self.triangles[t];
+            if facing[t] > 0 { [a, b, c] } else { [a, c, b] }
+        };
+        let sides: usize = casting().map(|(t, _)| (0..3).filter(|&k| casts_side(3 * t + k)).count()).sum();
+        let casters = casting().count();
+        let (per_side, far_caps) = if end == VolumeEnd::Infinity { (3, 0) } else { (6, 3 * casters) };
+        out.reserve(3 * casters + per_side * sides + far_caps);
+        let start = out.len() as u32;
+        for (t, _) in casting() {
+            out.extend(turned(t).map(|v| v.extend(1.0)));
+        }
+        let caps_end = out.len() as u32;
+        for (t, &face) in casting() {
+            for k in (0..3).filter(|&k| casts_side(3 * t + k)) {
+                let (p, q) = (self.triangles[t][k], self.triangles[t][(k + 1) % 3]);
+                let (p, q) = if face > 0 { (p, q) } else { (q, p) };
+                match end {
+                    VolumeEnd::Infinity => out.extend([q.extend(1.0), p.extend(1.0), far(p)]),
+                    VolumeEnd::Plane(_) => out.extend([q.extend(1.0), p.extend(1.0), far(p), q.extend(1.0), far(p), far(q)]),
                 }
             }
         }
-        volume.sides.extend(far_caps);
-        volume
+        if end != VolumeEnd::Infinity {
+            for (t, _) in casting() {
+                let [a, b, c] = turned(t);
+                out.extend([far(a), far(c), far(b)]);
+            }
+        }
+        (start..caps_end, caps_end..out.len() as u32)
     }
 }
 
