@@ -193,19 +193,18 @@ pub(super) fn upload_frame(
     if buffers.generation == Some(frame.generation) {
         return;
     }
-    let bytes = |floats: &[f32]| floats.iter().flat_map(|f| f.to_le_bytes()).collect::<Vec<u8>>();
+    // The buffers' bytes are the frame's own (no copy: the volumes of a
+    // large model are tens of megabytes, uploaded again each sun move).
     let buffer = |label: &str, contents: &[u8], usage: BufferUsages| {
         (!contents.is_empty()).then(|| device.create_buffer_with_data(&BufferInitDescriptor { label: Some(label), contents, usage }))
     };
-    let vertex_buffer = |label: &str, contents: &[u8]| buffer(label, contents, BufferUsages::VERTEX);
     let same_lit = buffers.lit.as_ref().is_some_and(|(surfaces, _)| Arc::ptr_eq(surfaces, &frame.surfaces));
     if !same_lit {
-        buffers.lit = vertex_buffer("heliodon_sun_lit", &bytes(&frame.surfaces.lit)).map(|b| (frame.surfaces.clone(), b));
+        buffers.lit = buffer("heliodon_sun_lit", bytemuck::cast_slice(&frame.surfaces.lit), BufferUsages::VERTEX)
+            .map(|b| (frame.surfaces.clone(), b));
     }
-    let volume_floats: Vec<f32> = frame.volumes.iter().flat_map(|v| v.to_array()).collect();
-    buffers.volumes = vertex_buffer("heliodon_sun_volumes", &bytes(&volume_floats));
-    let indices: Vec<u8> = frame.lit_indices.iter().flat_map(|i| i.to_le_bytes()).collect();
-    buffers.lit_indices = buffer("heliodon_sun_lit_indices", &indices, BufferUsages::INDEX);
+    buffers.volumes = buffer("heliodon_sun_volumes", bytemuck::cast_slice(&frame.volumes), BufferUsages::VERTEX);
+    buffers.lit_indices = buffer("heliodon_sun_lit_indices", bytemuck::cast_slice(&frame.lit_indices), BufferUsages::INDEX);
     buffers.lights.clear();
     let offsets: Vec<u32> =
         frame.lights().map(|l| buffers.lights.push(&SunLightUniform { direction: l.direction, irradiance: l.irradiance })).collect();
