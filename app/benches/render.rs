@@ -132,7 +132,7 @@ fn ready_app(scene: PathBuf, mode: RenderMode) -> (App, String) {
             frame.passes.len(),
             frame.lights().count(),
             frame.volumes.len() / 3,
-            frame.surfaces.lit.len() / 27,
+            frame.surfaces.lit_triangles(),
             frame.lit_triangles_drawn(),
             sun_pass_geometry_ms(&app, frame),
         ),

@@ -3,7 +3,7 @@
 //! data for the renderer to upload. The algorithm (the thesis' algorithm 1)
 //! and the GPU side are described in the renderer's `render::sun_pass`.
 //!
-//! - [`shadow_volume`]: per-triangle volumes for a directional light,
+//! - [`Casters`] (`shadow_volume.rs`): per-triangle volumes for a directional light,
 //!   silhouette edges only where the casters are manifold;
 //! - [`SunPassFrame::new`]: one [`DirectionPass`] per light direction (the
 //!   sun, then every panel lobe as a fake sun), its opaque casters' volume
@@ -23,7 +23,7 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3, Vec4};
 
-pub use shadow_volume::{Casters, ShadowVolume, VolumeEnd, shadow_volume};
+pub use shadow_volume::{Casters, VolumeEnd};
 
 use crate::light::{Glass, LightModel};
 use crate::scene::{MaterialKind, Scene, clip_convex};
@@ -41,7 +41,8 @@ pub struct SunLight {
     /// every window's volume counted as blocking.
     pub aperture: Option<Range<u32>>,
     /// The lit surfaces drawn for it: a range of [`SunPassFrame::lit_indices`]
-    /// (those its beam through the aperture can reach), or `None`: all.
+    /// (those its beam through the aperture can reach; never empty: a beam
+    /// that reaches no lit surface is no light of the frame), or `None`: all.
     pub lit: Option<Range<u32>>,
 }
 
@@ -110,7 +111,8 @@ impl SunPassFrame {
             .collect();
         let mut volumes: Vec<Vec4> = Vec::new();
         // Volumes end a metre past the ground drawn outside (or above the model, for light going up).
-        let end = |direction: Vec3| VolumeEnd::beyond(GroundPlane::of(scene).height, scene.bounds.1.z, direction);
+        let ground = GroundPlane::of(scene).height;
+        let end = |direction: Vec3| VolumeEnd::beyond(ground, scene.bounds.1.z, direction);
         let add_volume =
             |casters: &Casters, direction: Vec3, volumes: &mut Vec<Vec4>| casters.volume_into(direction, end(direction), volumes);
         let direction_pass = |(opaque_caps, opaque_sides): (Range<u32>, Range<u32>)| DirectionPass {
@@ -142,9 +144,11 @@ impl SunPassFrame {
                         _ => 1.0,
                     };
                     if cos.abs() > 1e-6 {
-                        let irradiance = (sun.normal_irradiance() * transmittance) as f32;
                         let lit = runs.reached(panes, to_sun, &mut lit_indices);
-                        sun_pass.lights.push(SunLight { direction: to_sun, irradiance, aperture: Some(volume), lit: Some(lit) });
+                        if !lit.is_empty() {
+                            let irradiance = (sun.normal_irradiance() * transmittance) as f32;
+                            sun_pass.lights.push(SunLight { direction: to_sun, irradiance, aperture: Some(volume), lit: Some(lit) });
+                        }
                     }
                 }
                 Key::Panel(group) => {
@@ -157,6 +161,10 @@ impl SunPassFrame {
                     let inner_casters = Casters::new(beside(opaque_casters, panes[0][0], inside));
                     for beam in beams.iter().filter(|b| b.panel_group == Some(*group)) {
                         let direction = beam.to_light.as_vec3();
+                        let lit = runs.reached(panes, direction, &mut lit_indices);
+                        if lit.is_empty() {
+                            continue;
+                        }
                         let mut pass = direction_pass(add_volume(&inner_casters, direction, &mut volumes));
                         let (_, shadow_sides) = add_volume(&shadows, direction, &mut volumes);
                         pass.opaque_sides.end = shadow_sides.end;
@@ -165,7 +173,7 @@ impl SunPassFrame {
                             direction,
                             irradiance: beam.normal_irradiance as f32,
                             aperture: Some(caps.start..sides.end),
-                            lit: Some(runs.reached(panes, direction, &mut lit_indices)),
+                            lit: Some(lit),
                         });
                         lobe_passes.push(pass);
                     }
@@ -180,7 +188,7 @@ impl SunPassFrame {
 
     /// Lit triangles rasterized per frame, all lights together.
     pub fn lit_triangles_drawn(&self) -> usize {
-        let all = self.surfaces.lit.len() / 27;
+        let all = self.surfaces.lit_triangles();
         self.lights().map(|l| l.lit.as_ref().map_or(all, |range| range.len() / 3)).sum()
     }
 
@@ -192,14 +200,9 @@ impl SunPassFrame {
     /// Draw calls per frame: per pass the opaque caps and sides, per light
     /// through an aperture its volume twice and the lit surfaces, for the
     /// outside light the windows' volumes and the lit surfaces; plus the
-    /// depth copy. A light whose beam reaches no lit surface draws nothing.
+    /// depth copy.
     pub fn draw_count(&self) -> usize {
-        let light_draws = |l: &SunLight| match (&l.aperture, &l.lit) {
-            (Some(_), Some(share)) if share.is_empty() => 0,
-            (Some(_), _) => 3,
-            (None, _) => 2,
-        };
-        1 + self.passes.iter().map(|p| 2 + p.lights.iter().map(light_draws).sum::<usize>()).sum::<usize>()
+        1 + self.passes.iter().map(|p| 2 + p.lights.iter().map(|l| if l.aperture.is_some() { 3 } else { 2 }).sum::<usize>()).sum::<usize>()
     }
 }
 
@@ -225,6 +228,11 @@ impl SunPassSurfaces {
             .map(|t| t.vertices)
             .collect();
         Self { runs: LitRuns::new(&lit), lit, opaque: Casters::new(opaque) }
+    }
+
+    /// How many lit triangles there are (9 floats per vertex).
+    pub fn lit_triangles(&self) -> usize {
+        self.lit.len() / 27
     }
 }
 

@@ -23,18 +23,6 @@ use rustc_hash::FxHashMap;
 /// no volume (their shadow has no area).
 const EDGE_ON: f32 = 1e-6;
 
-/// A closed shadow volume as triangles: the casters' faces (near caps) and
-/// the sides from their silhouette and open edges to where the volume ends.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct ShadowVolume {
-    /// The casters' own faces, turned to face the light (the near caps).
-    pub caps: Vec<Vec4>,
-    /// Per silhouette or open edge, its side: one triangle to the point at
-    /// infinity away from the light (w = 0), or a quad down to the plane the
-    /// volume ends on; then, for such a plane, the casters' far caps there.
-    pub sides: Vec<Vec4>,
-}
-
 /// Where volumes end away from the light.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum VolumeEnd {
@@ -60,15 +48,6 @@ impl VolumeEnd {
             _ => Self::Infinity,
         }
     }
-}
-
-/// The volume shaded by `casters` from light arriving along `-to_light`
-/// (`to_light` is the unit vector toward the light). A caster's lit face is
-/// its volume's near cap: the stencil pass biases the caps, and only them,
-/// away from the camera so that face counts as outside; biased sides would
-/// move the shadow's edges.
-pub fn shadow_volume(casters: &[[Vec3; 3]], to_light: Vec3, end: VolumeEnd) -> ShadowVolume {
-    Casters::new(casters.to_vec()).volume(to_light, end)
 }
 
 /// Casters with their shared edges found once: which edges meet does not
@@ -135,21 +114,17 @@ impl Casters {
         &self.triangles
     }
 
-    /// The volume they shade from light arriving along `-to_light` (see
-    /// [`shadow_volume`]).
-    pub fn volume(&self, to_light: Vec3, end: VolumeEnd) -> ShadowVolume {
-        let mut caps = Vec::new();
-        let (near, _) = self.volume_into(to_light, end, &mut caps);
-        let sides = caps.split_off(near.end as usize);
-        ShadowVolume { caps, sides }
-    }
-
-    /// Appends the volume to `out` (a large model's is tens of megabytes,
-    /// made again each sun move, so it is written once, in place): the near
-    /// caps, then the sides and the far caps. Returns the caps' range there
-    /// and that of the rest. Each caster is turned to face the light; two
-    /// edges between the same points that, turned, run opposite ways belong
-    /// to one shell and cast no side.
+    /// Appends the volume they shade from light arriving along `-to_light`
+    /// (`to_light` is the unit vector toward the light) to `out` (a large
+    /// model's is tens of megabytes, made again each sun move, so it is
+    /// written once, in place): the near caps, then the sides and the far
+    /// caps. Returns the caps' range there and that of the rest.
+    ///
+    /// Each caster is turned to face the light; two edges between the same
+    /// points that, turned, run opposite ways belong to one shell and cast
+    /// no side. A caster's lit face is its volume's near cap: the stencil
+    /// pass biases the caps, and only them, away from the camera so that
+    /// face counts as outside; biased sides would move the shadow's edges.
     pub fn volume_into(&self, to_light: Vec3, end: VolumeEnd, out: &mut Vec<Vec4>) -> (Range<u32>, Range<u32>) {
         // Where a point's shadow ends (every caster lies on the light's side of the plane).
         let far = |p: Vec3| match end {
@@ -228,6 +203,20 @@ mod tests {
     use std::collections::HashMap;
 
     use super::*;
+
+    /// A volume's near caps and the rest (sides and far caps), apart.
+    #[derive(Debug, Default, PartialEq)]
+    struct ShadowVolume {
+        caps: Vec<Vec4>,
+        sides: Vec<Vec4>,
+    }
+
+    fn shadow_volume(casters: &[[Vec3; 3]], to_light: Vec3, end: VolumeEnd) -> ShadowVolume {
+        let mut caps = Vec::new();
+        let (near, _) = Casters::new(casters.to_vec()).volume_into(to_light, end, &mut caps);
+        let sides = caps.split_off(near.end as usize);
+        ShadowVolume { caps, sides }
+    }
 
     /// A closed surface: every directed edge meets its reverse equally often.
     fn is_closed(volume: &ShadowVolume) -> bool {

@@ -106,8 +106,6 @@ pub(super) fn sun_pass(
         draw_volumes!(count_volume, direction.opaque_sides.clone());
         for light in &direction.lights {
             match &light.aperture {
-                // A beam that reaches no lit surface draws nothing.
-                Some(_) if light.lit.as_ref().is_some_and(|share| share.is_empty()) => {}
                 Some(aperture) => {
                     draw_volumes!(toggle_volume, aperture.clone());
                     draw_lit!(WINDOW_BIT, light.lit.as_ref());
