@@ -53,6 +53,11 @@ impl KeyRadiance {
 
     /// Sunlight that panels transmit diffusely (W/m²), seen through them.
     pub(super) fn panel_sun_irradiance(&self, gather: &Gather) -> f64 {
+        // No panel diffuses sun (none in the scene, or no sun on them): the
+        // sum would be 0 (read for every sensor every hour of a year).
+        if self.panel_sun.iter().all(|&radiance| radiance == 0.0) {
+            return 0.0;
+        }
         PI * gather.daylight_coefficients.iter().map(|&(k, w)| f64::from(w) * self.sun_of(k)).sum::<f64>()
     }
 

@@ -375,11 +375,13 @@ impl Sky {
     /// unit direction `d`, without the sun: the sky term blended into the
     /// ground glow around the horizon as skybright.cal does.
     pub fn radiance(&self, d: DVec3) -> f64 {
-        self.radiance_toward(&SkyDirection::new(d))
+        self.radiance_toward(&SkyDirection::new(d), None)
     }
 
     /// [`Self::radiance`] for a direction whose own terms are computed already.
-    pub fn radiance_toward(&self, d: &SkyDirection) -> f64 {
+    /// `height_term`: the sky's [`Self::height_terms`] of the direction's
+    /// height, when known.
+    pub fn radiance_toward(&self, d: &SkyDirection, height_term: Option<f64>) -> f64 {
         // Deep below the horizon the sky's weight (under 1e-9) would not
         // show in any reading: the ground glow alone, without evaluating
         // the sky (the annual study asks for every bin every hour).
@@ -389,10 +391,22 @@ impl Sky {
         let sky = match &self.distribution {
             Distribution::Dark => return 0.0,
             Distribution::Gensky(g) => g.sky(d),
-            Distribution::Perez(p) => p.sky(d.d),
+            Distribution::Perez(p) => p.sky_with_gradation(d.d, height_term.unwrap_or_else(|| p.gradation(d.d.z))),
             Distribution::Cie(c) => c.sky(d.d),
         };
         d.blend * sky + (1.0 - d.blend) * self.ground_radiance
+    }
+
+    /// What the sky's radiance toward every direction of each height in
+    /// `heights` (unit vectors' z) shares, for [`Self::radiance_toward`]:
+    /// the Perez sky's gradation (half its exponentials, where a quadrature
+    /// evaluates a whole row of cells of one height); empty for the others,
+    /// whose own terms of a direction [`SkyDirection`] holds.
+    pub fn height_terms(&self, heights: &[f64]) -> Vec<f64> {
+        match &self.distribution {
+            Distribution::Perez(p) => heights.iter().map(|&z| p.gradation(z)).collect(),
+            _ => Vec::new(),
+        }
     }
 
     /// The gensky distribution's printed arguments, for comparisons.

@@ -45,6 +45,11 @@ pub struct SkyPatches {
     samples: Vec<SkyDirection>,
     mirrored: Vec<SkyDirection>,
     sample_ranges: Vec<Range<u32>>,
+    /// The samples' heights (z), each once: a patch's cells lie in rows of
+    /// one height, and rows of patches share them.
+    heights: Vec<f64>,
+    /// Per sample, then per mirrored sample: its height's index.
+    height_of: Vec<u16>,
 }
 
 impl SkyPatches {
@@ -89,9 +94,22 @@ impl SkyPatches {
                 });
             }
         }
-        let mirrored = samples.iter().map(|d: &DVec3| SkyDirection::new(DVec3::new(d.x, d.y, -d.z))).collect();
-        let samples = samples.into_iter().map(SkyDirection::new).collect();
-        Self { subdivision: n, patches, samples, mirrored, sample_ranges }
+        let mirrored: Vec<SkyDirection> = samples.iter().map(|d: &DVec3| SkyDirection::new(DVec3::new(d.x, d.y, -d.z))).collect();
+        let samples: Vec<SkyDirection> = samples.into_iter().map(SkyDirection::new).collect();
+        let mut heights: Vec<f64> = Vec::new();
+        let height_of = samples
+            .iter()
+            .chain(&mirrored)
+            .map(|d| {
+                // Cells of a row come together: the last height is the likely one.
+                let index = heights.iter().rposition(|&z| z.to_bits() == d.d.z.to_bits()).unwrap_or_else(|| {
+                    heights.push(d.d.z);
+                    heights.len() - 1
+                });
+                u16::try_from(index).expect("a few hundred heights")
+            })
+            .collect();
+        Self { subdivision: n, patches, samples, mirrored, sample_ranges, heights, height_of }
     }
 
     /// Number of patches: 144·n² + 1.
@@ -128,13 +146,21 @@ impl SkyPatches {
     /// Each patch's mean radiance under `sky` (sun excluded), into `out`.
     pub fn integrate_into(&self, sky: &Sky, out: &mut Vec<f64>) {
         out.clear();
-        self.extend_means(sky, &self.samples, out);
+        self.extend_means(sky, false, &sky.height_terms(&self.heights), out);
     }
 
-    fn extend_means(&self, sky: &Sky, samples: &[SkyDirection], out: &mut Vec<f64>) {
+    /// Appends each patch's mean of `sky` over its cells, or over their
+    /// mirrors below the horizon; `height_terms`: [`Sky::height_terms`] of
+    /// the samples' heights.
+    fn extend_means(&self, sky: &Sky, mirrored: bool, height_terms: &[f64], out: &mut Vec<f64>) {
+        let (samples, height_of) = match mirrored {
+            false => (&self.samples, &self.height_of[..self.samples.len()]),
+            true => (&self.mirrored, &self.height_of[self.samples.len()..]),
+        };
         out.extend(self.sample_ranges.iter().map(|range| {
-            let cells = &samples[range.start as usize..range.end as usize];
-            cells.iter().map(|d| sky.radiance_toward(d)).sum::<f64>() / cells.len() as f64
+            let range = range.start as usize..range.end as usize;
+            let cells = samples[range.clone()].iter().zip(&height_of[range.clone()]);
+            cells.map(|(d, &h)| sky.radiance_toward(d, height_terms.get(usize::from(h)).copied())).sum::<f64>() / range.len() as f64
         }));
     }
 
@@ -155,8 +181,10 @@ impl SkyPatches {
 
     /// Mean radiance of every sphere bin ([`Self::sphere_bin`]) under `sky`, sun excluded.
     pub fn integrate_sphere_into(&self, sky: &Sky, out: &mut Vec<f64>) {
-        self.integrate_into(sky, out);
-        self.extend_means(sky, &self.mirrored, out);
+        let height_terms = sky.height_terms(&self.heights);
+        out.clear();
+        self.extend_means(sky, false, &height_terms, out);
+        self.extend_means(sky, true, &height_terms, out);
     }
 
     /// Total solid angle: 2π up to rounding.
@@ -180,6 +208,28 @@ mod tests {
             let projected: f64 = patches.patches.iter().map(|p| p.projected_solid_angle).sum();
             assert!((projected - PI).abs() < 1e-9);
         }
+    }
+
+    /// A Perez sky's gradation, computed once per height of cells, gives
+    /// every sphere bin's mean bit for bit as evaluating each cell alone;
+    /// the quadrature's cells lie in a few rows of one height.
+    #[test]
+    fn cells_of_one_height_share_the_perez_gradation() {
+        let patches = SkyPatches::reinhart(4);
+        assert!(patches.heights.len() < 150, "{} heights", patches.heights.len());
+        let input = crate::sky::perez::Input::Irradiance { direct_normal: 420.0, diffuse_horizontal: 180.0 };
+        let sky = Sky::new(&crate::sky::SkySpec::Perez(input), 23.0, 131.0, 0.2, 172).unwrap();
+        assert!(!sky.height_terms(&patches.heights).is_empty());
+        let mut bins = Vec::new();
+        patches.integrate_sphere_into(&sky, &mut bins);
+        let each_alone = |samples: &[SkyDirection]| -> Vec<f64> {
+            let mean =
+                |r: &Range<u32>| samples[r.start as usize..r.end as usize].iter().map(|d| sky.radiance(d.d)).sum::<f64>() / r.len() as f64;
+            patches.sample_ranges.iter().map(mean).collect()
+        };
+        let alone: Vec<f64> = each_alone(&patches.samples).into_iter().chain(each_alone(&patches.mirrored)).collect();
+        assert_eq!(bins.len(), 2 * patches.len());
+        assert!(bins.iter().zip(&alone).all(|(a, b)| a.to_bits() == b.to_bits()));
     }
 
     #[test]

@@ -225,7 +225,19 @@ fn relative_luminance(c: &[f64; 5], cos_dzeta: f64, gamma: f64) -> f64 {
 /// [`relative_luminance`] with cos γ known (a sky sample has it as its dot
 /// product with the sun, and it is evaluated for every bin every hour).
 fn relative_luminance_cos(c: &[f64; 5], cos_dzeta: f64, gamma: f64, cos_gamma: f64) -> f64 {
-    (1.0 + c[0] * (c[1] / cos_dzeta).exp()) * (1.0 + c[2] * (c[3] * gamma).exp() + c[4] * cos_gamma * cos_gamma)
+    gradation(c, cos_dzeta) * indicatrix(c, gamma, cos_gamma)
+}
+
+/// The relative luminance's factor of the zenith angle alone (Perez's
+/// gradation, 1 + a·exp(b / cos ζ)).
+fn gradation(c: &[f64; 5], cos_dzeta: f64) -> f64 {
+    1.0 + c[0] * (c[1] / cos_dzeta).exp()
+}
+
+/// The relative luminance's factor of the angle to the sun alone (Perez's
+/// indicatrix, 1 + c·exp(d·γ) + e·cos²γ).
+fn indicatrix(c: &[f64; 5], gamma: f64, cos_gamma: f64) -> f64 {
+    1.0 + c[2] * (c[3] * gamma).exp() + c[4] * cos_gamma * cos_gamma
 }
 
 /// gendaylit's normalisation integral: Σ lv·cos θ · 2π/145 over its 145
@@ -327,8 +339,20 @@ pub fn compute(input: Input, altitude: f64, azimuth: f64, day_of_year: f64, grou
 impl Perez {
     /// perezlum.cal's sky term (before the blend into the ground glow).
     pub fn sky(&self, d: DVec3) -> f64 {
+        self.sky_with_gradation(d, self.gradation(d.z))
+    }
+
+    /// The sky term's factor of a direction's height `z` alone: directions
+    /// of one height share it (a quadrature's row of cells), so it is
+    /// computed once for them.
+    pub fn gradation(&self, z: f64) -> f64 {
+        gradation(&self.coefficients, z.max(0.01))
+    }
+
+    /// [`Self::sky`] with the direction's [`Self::gradation`] known.
+    pub fn sky_with_gradation(&self, d: DVec3, gradation: f64) -> f64 {
         let cos_gamma = d.dot(self.sun).clamp(-1.0, 1.0);
-        self.normalisation * relative_luminance_cos(&self.coefficients, d.z.max(0.01), cos_gamma.acos(), cos_gamma)
+        self.normalisation * (gradation * indicatrix(&self.coefficients, cos_gamma.acos(), cos_gamma))
     }
 
     /// The sun direction the sky function uses (lowered to 87°).
