@@ -219,13 +219,7 @@ fn coefficients(zenith: f64, clearness: f64, brightness: f64) -> [f64; 5] {
 /// Relative luminance for a point at zenith angle `dzeta` and angle `gamma`
 /// from the sun (radians).
 fn relative_luminance(c: &[f64; 5], cos_dzeta: f64, gamma: f64) -> f64 {
-    relative_luminance_cos(c, cos_dzeta, gamma, gamma.cos())
-}
-
-/// [`relative_luminance`] with cos γ known (a sky sample has it as its dot
-/// product with the sun, and it is evaluated for every bin every hour).
-fn relative_luminance_cos(c: &[f64; 5], cos_dzeta: f64, gamma: f64, cos_gamma: f64) -> f64 {
-    gradation(c, cos_dzeta) * indicatrix(c, gamma, cos_gamma)
+    gradation(c, cos_dzeta) * indicatrix(c, gamma, gamma.cos())
 }
 
 /// The relative luminance's factor of the zenith angle alone (Perez's
