@@ -16,7 +16,9 @@
 //! cache beside the scene's precomputation ([`SunHours::cached`]), keyed by
 //! what it depends on beyond it: every material's light (reflectances,
 //! glass, panel keys), the site, the shade groups. A study that reads
-//! hours the stored table lacks traces again, the hours of both, so two
+//! hours the stored table lacks traces those hours alone and stores a
+//! table of both (the stored rows copied): an `--hourly` run after a plain
+//! one traces the unoccupied sunny hours, not the year again, and two
 //! weather files of one site settle on one table.
 
 use std::path::Path;
@@ -113,8 +115,8 @@ impl SunHours {
             return None;
         }
         let key = Self::key(model, site, shades);
-        // The hours a stored table holds that this study does not read: traced again with ours.
-        let stored_hours = std::cell::RefCell::new(vec![false; HOURS]);
+        // A stored table lacking some of our hours: its rows are kept, ours added.
+        let stored = std::cell::RefCell::new(None);
         cache::through_streamed_cache(
             dir,
             &format!("{key:016x}-sun-hours"),
@@ -124,42 +126,60 @@ impl SunHours {
                 if table.holds(hours) {
                     return Ok(table);
                 }
-                *stored_hours.borrow_mut() = table.row_of_hour.iter().map(|row| *row != HourRow::NotTraced).collect();
+                *stored.borrow_mut() = Some(table);
                 Err(LACKS_HOURS.to_string())
             },
             |out| {
-                // Our hours alone when the stored table adds none, or the union would not fit.
-                let both: Vec<bool> = hours.iter().zip(stored_hours.borrow().iter()).map(|(ours, stored)| *ours || *stored).collect();
-                let both = (both != hours).then(|| sun_directions(site, &both)).filter(|suns| fits(suns));
-                Self::trace(model, coefficients, site, both.as_deref().unwrap_or(&ours), shade_groups, out, progress)
+                // Both tables' hours, unless the union would not fit: then ours alone.
+                let stored = stored.take().and_then(|table| {
+                    let both: Vec<bool> =
+                        hours.iter().zip(&table.row_of_hour).map(|(ours, row)| *ours || *row != HourRow::NotTraced).collect();
+                    let suns = sun_directions(site, &both);
+                    fits(&suns).then_some((table, suns))
+                });
+                match &stored {
+                    Some((table, suns)) => Self::trace(model, coefficients, site, suns, Some(table), shade_groups, out, progress),
+                    None => Self::trace(model, coefficients, site, &ours, None, shade_groups, out, progress),
+                }
             },
         )
     }
 
-    /// Traces the sun-up hours of `suns` (one per hour of the year, `None`
-    /// where not traced, `Some(None)` with the sun down) into `out`, a batch
-    /// of hours at a time.
+    /// Writes into `out` a table of the sun-up hours of `suns` (one per hour
+    /// of the year, `None` where not traced, `Some(None)` with the sun
+    /// down): the rows of `stored` copied as they are (their hours keep
+    /// their row numbers), the other hours traced after them, a batch of
+    /// hours at a time.
+    #[allow(clippy::too_many_arguments)]
     fn trace(
         model: &LightModel,
         coefficients: &SensorCoefficients,
         site: &Site,
         suns: &[Option<Option<DVec3>>],
+        stored: Option<&SunHours>,
         shade_groups: usize,
         out: &mut StreamedWriter,
         progress: &(dyn Fn(f64) + Sync),
     ) -> std::io::Result<()> {
-        let up: Vec<DVec3> = suns.iter().flatten().flatten().copied().collect();
-        let mut next = 0;
-        let row_of_hour = suns.iter().map(|d| match d {
-            Some(Some(_)) => {
-                next += 1;
-                next - 1
-            }
-            Some(None) => SUN_DOWN,
-            None => NOT_TRACED,
-        });
-        let counts = [model.scene.sensors.len(), shade_groups, up.len()].map(|n| n as u32);
+        let stored_row = |k: usize| stored.map(|table| table.row_of_hour[k]).filter(|row| *row != HourRow::NotTraced);
+        let stored_rows = stored.map_or(0, SunHours::rows);
+        let mut up = Vec::new();
+        let row_of_hour: Vec<u32> = (0..HOURS)
+            .map(|k| match (stored_row(k), suns[k]) {
+                (Some(HourRow::Row(row)), _) => row,
+                (Some(_), _) | (None, Some(None)) => SUN_DOWN,
+                (None, Some(Some(sun))) => {
+                    up.push(sun);
+                    (stored_rows + up.len() - 1) as u32
+                }
+                (None, None) => NOT_TRACED,
+            })
+            .collect();
+        let counts = [model.scene.sensors.len(), shade_groups, stored_rows + up.len()].map(|n| n as u32);
         out.append(&counts.into_iter().chain(row_of_hour).flat_map(u32::to_le_bytes).collect::<Vec<u8>>())?;
+        if let Some(table) = stored {
+            table.copy_rows(out)?;
+        }
         let path = SunPath::new(model, coefficients, site, &up, None);
         let done = AtomicUsize::new(0);
         for batch in up.chunks(HOURS_PER_BATCH) {
@@ -173,6 +193,29 @@ impl SunHours {
             for row in rows {
                 out.append(&row)?;
             }
+        }
+        Ok(())
+    }
+
+    /// How many rows the file holds.
+    fn rows(&self) -> usize {
+        ((self.file.len() - ROWS_AT) / self.row_bytes() as u64) as usize
+    }
+
+    /// Bytes of one hour's row.
+    fn row_bytes(&self) -> usize {
+        (2 + self.shade_groups) * self.sensors * size_of::<f32>()
+    }
+
+    /// Appends every row of the file to `out`, a piece at a time.
+    fn copy_rows(&self, out: &mut StreamedWriter) -> std::io::Result<()> {
+        let mut piece = vec![0u8; 1 << 20];
+        let mut at = ROWS_AT;
+        while at < self.file.len() {
+            let n = piece.len().min((self.file.len() - at) as usize);
+            self.file.read_at(at, &mut piece[..n])?;
+            out.append(&piece[..n])?;
+            at += n as u64;
         }
         Ok(())
     }
@@ -425,15 +468,24 @@ mod tests {
     }
 
     /// A table holds the hours it was traced for: a study reading others
-    /// traces again, keeping the hours of both, with the same numbers; an
-    /// hour nobody asked for is an error, never a dark hour, from the table
-    /// and from the year traced hour by hour alike.
+    /// traces those alone and keeps the hours of both, with the same
+    /// numbers as tables traced for each; an hour nobody asked for is an
+    /// error, never a dark hour, from the table and from the year traced
+    /// hour by hour alike.
     #[test]
     fn a_table_traced_for_some_hours_is_traced_again_for_more_and_keeps_both() {
         let (model, coefficients, site, dir) = test_room("union");
         let month = |m: u32| -> Vec<bool> { (0..HOURS).map(|k| calendar(k).0 == m).collect() };
         let (january, july) = (month(1), month(7));
-        let cached = |hours: &[bool]| SunHours::cached(&model, &coefficients, &site, false, hours, &dir, &|_| {}).expect("kept");
+        let traced_hours = AtomicUsize::new(0);
+        let cached = |hours: &[bool]| {
+            traced_hours.store(0, Ordering::Relaxed);
+            let count = |_| {
+                traced_hours.fetch_add(1, Ordering::Relaxed);
+            };
+            SunHours::cached(&model, &coefficients, &site, false, hours, &dir, &count).expect("kept")
+        };
+        let sun_up = |hours: &[bool]| (0..HOURS).filter(|&k| hours[k] && sun_direction(&site, k).is_some()).count();
         let (first, outcome) = cached(&january);
         assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");
         assert!(first.holds(&january) && !first.holds(&july));
@@ -442,13 +494,19 @@ mod tests {
         let traced = YearSun::traced(&model, &coefficients, &site, false, &january);
         assert!(traced.response(noon_in(7)).is_err(), "nor when the year's sun is traced hour by hour");
         assert_eq!(traced.response(noon_in(1)).unwrap(), first.response(noon_in(1)).unwrap());
+        assert_eq!(traced_hours.load(Ordering::Relaxed), sun_up(&january));
         let (both, outcome) = cached(&july);
         assert!(matches!(&outcome, CacheOutcome::Rebuilt(_, why) if why == LACKS_HOURS), "{outcome:?}");
         assert!(both.holds(&january) && both.holds(&july));
+        assert_eq!(traced_hours.load(Ordering::Relaxed), sun_up(&july), "January's hours are copied, not traced again");
         let (_, outcome) = cached(&january);
         assert!(matches!(outcome, CacheOutcome::Hit(_)), "{outcome:?}");
         for k in (0..HOURS).filter(|&k| january[k]) {
             assert_eq!(first.response(k).unwrap(), both.response(k).unwrap(), "hour {k}");
+        }
+        let july_alone = YearSun::traced(&model, &coefficients, &site, false, &july);
+        for k in (0..HOURS).filter(|&k| july[k]).step_by(7) {
+            assert_eq!(july_alone.response(k).unwrap(), both.response(k).unwrap(), "hour {k}");
         }
         let july_noon = both.response(noon_in(7)).unwrap().expect("the sun is up at a July noon");
         assert!(july_noon.direct.iter().chain(&july_noon.interreflected).any(|&e| e > 0.0));
