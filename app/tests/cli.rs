@@ -541,6 +541,14 @@ fn annual_refuses_bad_weather_and_scenes_without_sensors_in_one_line() {
         heliodon(&["annual", room.to_str().unwrap(), "--weather", full.to_str().unwrap(), "--occupied", "18:00-08:00"], &scratch());
     assert_eq!(code, 2);
     assert!(err.contains("--occupied") && err.contains("the end is not after the start"), "{err}");
+    // The hourly file is opened before the year is read: a folder that is not there fails at once.
+    let nowhere = dir.join("no-such-folder").join("hourly.csv");
+    let Run { code, err, .. } = heliodon(
+        &["annual", room.to_str().unwrap(), "--weather", full.to_str().unwrap(), "--hourly", nowhere.to_str().unwrap()],
+        &scratch(),
+    );
+    assert_eq!(code, 1);
+    assert!(err.lines().filter(|l| l.starts_with("error")).count() == 1 && err.contains("--hourly") && err.contains("hourly.csv"), "{err}");
 
     // Shade groups: checked where they are read.
     let blinds = "\n[materials.blinds]\nkind = \"glass\"\ntransmittance = 0.1\n";

@@ -24,6 +24,28 @@ fn load(path: &Path) -> Arc<Scene> {
     Arc::new(load_scene(path, &PanelCatalog::new()).unwrap().scene)
 }
 
+/// A year of `weather` on `model` with every hour's total lux kept,
+/// `[hour][sensor]`, checking they come in order.
+fn year_with_hours(
+    model: &LightModel,
+    site: &heliodon_core::site::Site,
+    weather: &heliodon_core::weather::Weather,
+    options: heliodon_core::annual::AnnualOptions,
+) -> (heliodon_core::annual::AnnualResult, Vec<Vec<f32>>) {
+    let hours = std::sync::Mutex::new(Vec::new());
+    let keep = |k: usize, values: &[f32]| {
+        let mut hours = hours.lock().unwrap();
+        assert_eq!(k, hours.len(), "hours go out in order");
+        hours.push(values.to_vec());
+        Ok(())
+    };
+    let options = heliodon_core::annual::AnnualOptions { hourly: Some(&keep), ..options };
+    let result = heliodon_core::annual::annual(model, site, weather, &options, &|_| {}).unwrap();
+    let hours = hours.into_inner().unwrap();
+    assert_eq!(hours.len(), heliodon_core::weather::HOURS);
+    (result, hours)
+}
+
 fn sideroom() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/sideroom/scene.toml")
 }
@@ -728,16 +750,17 @@ fn the_years_sun_is_cached_and_a_warm_year_reads_what_a_traced_one_does() {
     let station =
         Station { name: "synthetic".into(), latitude: site.latitude, longitude: site.longitude, timezone: site.timezone, elevation: 0.0 };
     let weather = Weather { station, hours };
-    let traced = annual(&model, &site, &weather, &AnnualOptions { keep_hourly: true, ..Default::default() }, &|_| {}).unwrap();
-    let options = AnnualOptions { keep_hourly: true, coefficients: Some(&coefficients), sun_hours: Some(&warm), ..Default::default() };
-    let read = annual(&model, &site, &weather, &options, &|_| {}).unwrap();
+    let traced = year_with_hours(&model, &site, &weather, AnnualOptions::default());
+    let options = AnnualOptions { coefficients: Some(&coefficients), sun_hours: Some(&warm), ..Default::default() };
+    let read = year_with_hours(&model, &site, &weather, options);
     assert_eq!(traced, read);
-    assert!(read.sensors.iter().any(|s| s.ase_hours > 0) && read.sensors.iter().all(|s| s.da300 > 0.0), "{:?}", read.sensors);
+    let sensors = &read.0.sensors;
+    assert!(sensors.iter().any(|s| s.ase_hours > 0) && sensors.iter().all(|s| s.da300 > 0.0), "{sensors:?}");
     // Through the cache folder the sensor coefficients are kept beside the
     // table and read back as solved: twice, the traced year.
-    let through_cache = AnnualOptions { keep_hourly: true, sun_cache: Some(&dir), ..Default::default() };
+    let through_cache = AnnualOptions { sun_cache: Some(&dir), ..Default::default() };
     for _ in 0..2 {
-        assert_eq!(annual(&model, &site, &weather, &through_cache, &|_| {}).unwrap(), traced);
+        assert_eq!(year_with_hours(&model, &site, &weather, through_cache), traced);
     }
     assert!(matches!(model.sensor_coefficients_cached(&dir).1, CacheOutcome::Hit(_)));
 
@@ -764,7 +787,7 @@ fn the_years_sun_is_cached_and_a_warm_year_reads_what_a_traced_one_does() {
 /// and the test room.
 #[test]
 fn annual_hours_read_what_sensors_reads_within_2_percent() {
-    use heliodon_core::annual::{AnnualOptions, annual, hour_time};
+    use heliodon_core::annual::{AnnualOptions, hour_time};
     use heliodon_core::weather::{HOURS, Station, Weather, WeatherHour, calendar};
     for name in ["office", "test_room"] {
         let scene = load(&heliodon_core::bundled_scene(name));
@@ -783,9 +806,7 @@ fn annual_hours_read_what_sensors_reads_within_2_percent() {
         let station =
             Station { name: "clear".into(), latitude: site.latitude, longitude: site.longitude, timezone: site.timezone, elevation: 0.0 };
         let weather = Weather { station, hours: hours.collect() };
-        let options = AnnualOptions { keep_hourly: true, ..Default::default() };
-        let year = annual(&model, &site, &weather, &options, &|_| {}).unwrap();
-        let hourly = year.hourly.unwrap();
+        let (_, hourly) = year_with_hours(&model, &site, &weather, AnnualOptions::default());
         let perez = SkySpec::Perez(heliodon_core::sky::perez::Input::Irradiance { direct_normal, diffuse_horizontal });
         let mut errors = Vec::new();
         for month in 1..=12 {

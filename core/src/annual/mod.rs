@@ -31,8 +31,9 @@
 //!    written as it is traced and read back an hour at a time, never held
 //!    whole; with no cache folder, or past [`MAX_TABLE_BYTES`] on disk,
 //!    the sun is traced hour by hour instead. Memory follows sensors × sky
-//!    bins and threads, not the hours (unless every hour is kept for
-//!    `--hourly`).
+//!    bins and threads, not the hours: with every hour asked for
+//!    (`--hourly`), each hour's readings go out in order as a run of days
+//!    is done ([`AnnualOptions::hourly`]), never held for the year.
 //! 4. ASE counts the direct sun alone (no sky, no interreflection).
 //!
 //! 5. LM-83 operable shades (`[[shades]]`): in each occupied hour a group
@@ -140,8 +141,6 @@ pub struct AnnualResult {
     /// Lit hours whose sky could not be made (they read 0): how many, and
     /// the first ("month/day hour h") with why ([`YearSkies::skipped`]).
     pub skipped: Option<(usize, String)>,
-    /// Total lux of every sensor for every hour, `[hour][sensor]`, when asked for.
-    pub hourly: Option<Vec<Vec<f32>>>,
 }
 
 impl AnnualResult {
@@ -292,8 +291,8 @@ pub struct AnnualOptions<'a> {
     /// The scene's `[[shades]]` (LM-83), when studied: makes the models
     /// with shades down.
     pub shades: Option<ShadedModel<'a>>,
-    /// Keep every hour's total lux (8,760 × sensors values).
-    pub keep_hourly: bool,
+    /// Where every hour's total lux goes, when asked for ([`HourlyReadings`]).
+    pub hourly: Option<HourlyReadings<'a>>,
     /// The model's sensor coefficients, when the caller has them already
     /// (a sweep of panel keys keeps one set for every combination).
     pub coefficients: Option<&'a SensorCoefficients>,
@@ -387,6 +386,16 @@ impl YearSkies {
 /// irradiance; `None` with the sun down.
 pub type HourlySun<'a> = &'a (dyn Fn(usize) -> Option<SunResponse> + Sync);
 
+/// Takes hour `k` of the year's total lux at every sensor (0 in the dark),
+/// called for every hour in order, from the thread running the year; an
+/// error stops the year with it.
+pub type HourlyReadings<'a> = &'a (dyn Fn(usize, &[f32]) -> Result<(), String> + Sync);
+
+/// Days read together before their hours go out in order
+/// ([`AnnualOptions::hourly`]): memory follows sensors × these days' hours,
+/// not the year, and the cores share the days of a run.
+const DAYS_PER_RUN: usize = 16;
+
 impl AnnualOptions<'_> {
     /// The hours of `weather`'s year whose sun the study reads (one per
     /// hour): lit, with direct normal irradiance, and occupied, or any such
@@ -396,7 +405,7 @@ impl AnnualOptions<'_> {
         weather
             .hours
             .iter()
-            .map(|h| h.direct_normal > 0.0 && h.diffuse_horizontal > 0.0 && (self.keep_hourly || self.occupancy.contains(h.hour)))
+            .map(|h| h.direct_normal > 0.0 && h.diffuse_horizontal > 0.0 && (self.hourly.is_some() || self.occupancy.contains(h.hour)))
             .collect()
     }
 }
@@ -405,8 +414,8 @@ impl AnnualOptions<'_> {
 /// groups whose windows let too much direct sun onto the point sensors and
 /// reads DA and UDI with them down (ASE always with every shade up).
 /// `progress` hears the share of days done (from any thread). Fails only
-/// when a shaded model cannot be made or the cached year's sun cannot be
-/// read.
+/// when a shaded model cannot be made, the cached year's sun cannot be
+/// read or `options.hourly` fails.
 pub fn annual(
     model: &LightModel,
     site: &Site,
@@ -414,7 +423,7 @@ pub fn annual(
     options: &AnnualOptions,
     progress: &(dyn Fn(f64) + Sync),
 ) -> Result<AnnualResult, String> {
-    let AnnualOptions { occupancy, shades, keep_hourly, .. } = *options;
+    let AnnualOptions { occupancy, shades, hourly, .. } = *options;
     let scene = &model.scene;
     let sensor_count = scene.sensors.len();
     // Through the light cache where the run has one.
@@ -497,11 +506,6 @@ pub fn annual(
         .collect();
 
     let days = HOURS / 24;
-    let done = std::sync::atomic::AtomicUsize::new(0);
-    // Runs of whole days, one per core: memory follows sensors × cores, not
-    // hours (unless every hour is kept). Hours are independent, so the
-    // split does not change a number.
-    let runs = std::thread::available_parallelism().map_or(1, |n| n.get());
     // (total with the hour's shades, direct sun with every shade up) per
     // sensor; `None` when the hour is dark.
     let readings = |k: usize| -> Result<Option<Vec<(f64, f64)>>, String> {
@@ -516,29 +520,39 @@ pub fn annual(
             None => open.iter().map(|r| (r.total, r.direct_sun)).collect(),
         }))
     };
-    let year = par_map(None, runs, |run| -> Result<(Tally, Vec<Vec<f32>>), String> {
+    // One day: its tally of occupied hours and, when every hour is asked
+    // for, its hours' totals.
+    let day = |d: usize| -> Result<(Tally, Vec<Vec<f32>>), String> {
         let mut tally = Tally::new(sensor_count);
-        let mut hourly = Vec::new();
-        let (first, end) = (run * days / runs * 24, (run + 1) * days / runs * 24);
-        for (k, (hour, &lowered)) in weather.hours.iter().zip(&down).enumerate().take(end).skip(first) {
+        let mut hours = Vec::new();
+        for (k, (hour, &lowered)) in weather.hours.iter().zip(&down).enumerate().skip(d * 24).take(24) {
             let occupied = occupancy.contains(hour.hour);
-            let readings = if occupied || keep_hourly { readings(k)? } else { None };
+            let readings = if occupied || hourly.is_some() { readings(k)? } else { None };
             if occupied {
                 tally.count(readings.as_deref(), lowered != 0);
             }
-            if keep_hourly {
-                hourly.push(readings.map_or_else(|| vec![0.0; sensor_count], |r| r.iter().map(|v| v.0 as f32).collect()));
-            }
-            if hour.hour == 24 {
-                let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                progress(tracing_share + (1.0 - tracing_share) * finished as f64 / days as f64);
+            if hourly.is_some() {
+                hours.push(readings.map_or_else(|| vec![0.0; sensor_count], |r| r.iter().map(|v| v.0 as f32).collect()));
             }
         }
-        Ok((tally, hourly))
-    })
-    .into_iter()
-    .collect::<Result<Vec<_>, String>>()?;
-    let tally = year.iter().fold(Tally::new(sensor_count), |sum, (run, _)| sum.merge(run));
+        Ok((tally, hours))
+    };
+    // Runs of days on every core; hours are independent, so the split does
+    // not change a number, and each run's hours go out before the next.
+    let mut tally = Tally::new(sensor_count);
+    for first in (0..days).step_by(DAYS_PER_RUN) {
+        let run = par_map(None, DAYS_PER_RUN.min(days - first), |d| day(first + d));
+        for (d, result) in run.into_iter().enumerate() {
+            let (day_tally, hours) = result?;
+            tally = tally.merge(&day_tally);
+            if let Some(hourly) = hourly {
+                for (h, readings) in hours.iter().enumerate() {
+                    hourly((first + d) * 24 + h, readings)?;
+                }
+            }
+        }
+        progress(tracing_share + (1.0 - tracing_share) * (first + DAYS_PER_RUN).min(days) as f64 / days as f64);
+    }
     let occupied_hours = tally.occupied;
     let percent = |n: u32| if occupied_hours == 0 { 0.0 } else { 100.0 * f64::from(n) / occupied_hours as f64 };
     let sensors = scene
@@ -555,8 +569,7 @@ pub fn annual(
             ase_hours: c[4] as usize,
         })
         .collect();
-    let hourly = keep_hourly.then(|| year.into_iter().flat_map(|(_, hours)| hours).collect());
-    Ok(AnnualResult { sensors, occupied_hours, shaded_hours: tally.shaded, skipped: year_skies.skipped(weather), hourly })
+    Ok(AnnualResult { sensors, occupied_hours, shaded_hours: tally.shaded, skipped: year_skies.skipped(weather) })
 }
 
 /// The shade groups (a bit each) that LM-83 lowers under `sky`, given the

@@ -2,9 +2,13 @@
 //! UDI, ASE hours, sDA, ASE), from one (cached) precomputation.
 
 use std::fmt::Write as _;
+use std::fs::File;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::annual::{AnnualOptions, AnnualResult, Occupancy, ShadedModel, annual, missing_in_daylight_note, skipped_hours_note};
+use crate::annual::{
+    AnnualOptions, AnnualResult, HourlyReadings, Occupancy, ShadedModel, annual, missing_in_daylight_note, skipped_hours_note,
+};
 use crate::cli::CliError;
 use crate::cli::args::{Format, load_for_command, precompute_for_command, progress_bar};
 use crate::light::cache;
@@ -55,21 +59,27 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     // The year's sun at the site: traced once, then from the cache for every
     // weather file (unless its table would not fit in memory: then hour by hour).
     let cache_dir = if args.no_cache { None } else { cache::default_dir() };
+    let hourly_csv = args.hourly.as_deref().map(|path| HourlyCsv::create(path, &scene, &weather)).transpose()?;
+    let write_hour = |k: usize, values: &[f32]| hourly_csv.as_ref().map_or(Ok(()), |csv| csv.row(k, values));
     let progress = progress_bar("the year's sun, then a year of hours");
     let options = AnnualOptions {
         occupancy: args.occupied,
         shades,
-        keep_hourly: args.hourly.is_some(),
+        hourly: hourly_csv.is_some().then_some(&write_hour as HourlyReadings),
         sun_cache: cache_dir.as_deref(),
         ..Default::default()
     };
     let result = annual(&model, site, &weather, &options, &|done| progress.set_position((done * 1000.0) as u64));
     progress.finish_and_clear();
-    let result = result?;
+    let result = match (result, hourly_csv) {
+        (Ok(result), Some(csv)) => csv.finish().map(|_| result),
+        (Err(why), Some(csv)) => {
+            csv.discard();
+            Err(why)
+        }
+        (result, None) => result,
+    }?;
     warn_about_skipped_hours(&args.weather, result.skipped.as_ref());
-    if let Some(path) = &args.hourly {
-        std::fs::write(path, hourly_csv(&result, &weather)).map_err(|e| format!("--hourly {}: {e}", path.display()))?;
-    }
     print!("{}", report(&result, args.format, &args.weather));
     Ok(())
 }
@@ -104,21 +114,63 @@ pub(crate) fn warn_about_skipped_hours(path: &Path, skipped: Option<&(usize, Str
     }
 }
 
-fn hourly_csv(result: &AnnualResult, weather: &Weather) -> String {
-    let mut out = String::from("month,day,hour");
-    for sensor in &result.sensors {
-        out.push(',');
-        out.push_str(&csv_field(&sensor.name));
-    }
-    out.push('\n');
-    for (hour, values) in weather.hours.iter().zip(result.hourly.iter().flatten()) {
-        let _ = write!(out, "{},{},{}", hour.month, hour.day, hour.hour);
-        for value in values {
-            let _ = write!(out, ",{value:.1}");
+/// `--hourly`'s file, written an hour at a time as the year is read: a
+/// header of the sensors' names, then each hour's `month,day,hour` and
+/// every sensor's total lux.
+struct HourlyCsv<'w> {
+    path: PathBuf,
+    out: std::sync::Mutex<std::io::BufWriter<std::fs::File>>,
+    weather: &'w Weather,
+}
+
+impl<'w> HourlyCsv<'w> {
+    /// Creates the file and writes its header.
+    fn create(path: &Path, scene: &crate::scene::Scene, weather: &'w Weather) -> Result<Self, String> {
+        let mut header = String::from("month,day,hour");
+        for sensor in &scene.sensors {
+            header.push(',');
+            header.push_str(&csv_field(&sensor.name));
         }
-        out.push('\n');
+        header.push('\n');
+        let csv = Self {
+            path: path.to_path_buf(),
+            out: std::sync::Mutex::new(std::io::BufWriter::new(File::create(path).map_err(|e| Self::why(path, e))?)),
+            weather,
+        };
+        csv.write(header.as_bytes())?;
+        Ok(csv)
     }
-    out
+
+    /// Hour `k`'s row.
+    fn row(&self, k: usize, values: &[f32]) -> Result<(), String> {
+        let hour = &self.weather.hours[k];
+        let mut line = format!("{},{},{}", hour.month, hour.day, hour.hour);
+        for value in values {
+            let _ = write!(line, ",{value:.1}");
+        }
+        line.push('\n');
+        self.write(line.as_bytes())
+    }
+
+    fn write(&self, bytes: &[u8]) -> Result<(), String> {
+        self.out.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).write_all(bytes).map_err(|e| Self::why(&self.path, e))
+    }
+
+    /// Writes out what is left.
+    fn finish(self) -> Result<(), String> {
+        self.out.into_inner().unwrap_or_else(|poisoned| poisoned.into_inner()).flush().map_err(|e| Self::why(&self.path, e))
+    }
+
+    /// Removes the unfinished file of a year that failed.
+    fn discard(self) {
+        let path = self.path.clone();
+        drop(self);
+        let _ = std::fs::remove_file(path);
+    }
+
+    fn why(path: &Path, e: std::io::Error) -> String {
+        format!("--hourly {}: {e}", path.display())
+    }
 }
 
 fn report(result: &AnnualResult, format: Format, weather_path: &std::path::Path) -> String {
