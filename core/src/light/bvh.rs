@@ -10,6 +10,7 @@ use obvhs::BvhBuildParams;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::ray::{Ray, RayHit};
+use obvhs::rt_triangle::RtTriangle;
 use obvhs::triangle::Triangle;
 
 use crate::scene::PatchMesh;
@@ -29,7 +30,11 @@ pub struct Hit {
 /// A BVH over a patch mesh's render triangles.
 pub struct Tracer {
     bvh: CwBvh,
-    triangles: Vec<Triangle>,
+    /// The triangles in the BVH's leaf order (`bvh.primitive_indices`),
+    /// edges and normal ready for intersection (the same arithmetic as
+    /// [`Triangle::intersect`], with no lookup through the index).
+    triangles: Vec<RtTriangle>,
+    /// Each of them's owner, in that order.
     owner: Vec<u32>,
 }
 
@@ -46,6 +51,9 @@ impl Tracer {
             .map(|t| Triangle { v0: to_bvh(t[0].as_dvec3()), v1: to_bvh(t[1].as_dvec3()), v2: to_bvh(t[2].as_dvec3()) })
             .collect();
         let bvh = build_cwbvh_from_tris(&triangles, BvhBuildParams::medium_build(), &mut Duration::default());
+        let leaf_order = || bvh.primitive_indices.iter().map(|&k| k as usize);
+        let owner = leaf_order().map(|k| owner[k]).collect();
+        let triangles = leaf_order().map(|k| RtTriangle::from(&triangles[k])).collect();
         Self { bvh, triangles, owner }
     }
 
@@ -57,8 +65,8 @@ impl Tracer {
         let ray = Ray::new(to_bvh(origin), to_bvh(direction), t_min as f32, f32::INFINITY);
         let mut hit = RayHit::none();
         self.bvh
-            .ray_traverse(ray, &mut hit, |ray, id| self.triangles[self.bvh.primitive_indices[id] as usize].intersect(ray))
-            .then(|| Hit { patch: self.owner[self.bvh.primitive_indices[hit.primitive_id as usize] as usize], distance: f64::from(hit.t) })
+            .ray_traverse(ray, &mut hit, |ray, id| self.triangles[id].intersect(ray))
+            .then(|| Hit { patch: self.owner[hit.primitive_id as usize], distance: f64::from(hit.t) })
     }
 
     /// Every surface along a ray between `t_min` and `t_max`, in no
@@ -71,7 +79,7 @@ impl Tracer {
         let mut node;
         'traversal: {
             obvhs::traverse!(self.bvh, node, state, node.intersect_ray(&ray, state.oct_inv4), {
-                let triangle = self.bvh.primitive_indices[state.primitive_id as usize] as usize;
+                let triangle = state.primitive_id as usize;
                 let t = self.triangles[triangle].intersect(&ray);
                 if t < ray.tmax && !visit(Hit { patch: self.owner[triangle], distance: f64::from(t) }) {
                     break 'traversal;
