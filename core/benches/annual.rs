@@ -3,9 +3,11 @@
 //! bundled office (150 sensors) and the validation side room (19), cold
 //! (gather, coefficients, the year's sun traced, the year) and with the
 //! light cache warm (what `annual` does then: the gathers and the year's
-//! sun read from a cache folder, the coefficients, the year). The parts are
+//! sun read from a cache folder, the coefficients, the year), and warm with
+//! every hour's readings formatted as `--hourly` writes them. The parts are
 //! printed once beside the measurements.
 
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -35,6 +37,24 @@ fn scenes() -> Vec<(&'static str, Arc<Scene>)> {
 
 fn year(model: &LightModel, weather: &Weather, cache: Option<&Path>) -> f64 {
     annual(model, &model.scene.site, weather, &AnnualOptions { sun_cache: cache, ..Default::default() }, &|_| {}).unwrap().sda()
+}
+
+/// [`year`] with every hour's readings formatted as `annual --hourly`'s
+/// CSV rows (and dropped).
+fn year_with_every_hour(model: &LightModel, weather: &Weather, cache: Option<&Path>) -> f64 {
+    let formatted = std::sync::atomic::AtomicUsize::new(0);
+    let row = |_: usize, values: &[f32]| {
+        let mut line = String::from("1,1,1");
+        for value in values {
+            let _ = write!(line, ",{value:.1}");
+        }
+        formatted.fetch_add(line.len(), std::sync::atomic::Ordering::Relaxed);
+        Ok(())
+    };
+    let options = AnnualOptions { sun_cache: cache, hourly: Some(&row), ..Default::default() };
+    let sda = annual(model, &model.scene.site, weather, &options, &|_| {}).unwrap().sda();
+    std::hint::black_box(formatted.into_inner());
+    sda
 }
 
 fn bench(c: &mut Criterion) {
@@ -71,6 +91,12 @@ fn bench(c: &mut Criterion) {
         };
         warm();
         group.bench_function(format!("{name}: year, light cache warm"), |b| b.iter(warm));
+        let warm_every_hour = || {
+            let (model, _) = precompute_cached(scene.clone(), LightSettings::default(), Some(&cache), &|_| {}).unwrap();
+            year_with_every_hour(&model, &weather, Some(&cache))
+        };
+        warm_every_hour();
+        group.bench_function(format!("{name}: year with every hour (--hourly), light cache warm"), |b| b.iter(warm_every_hour));
         group.bench_function(format!("{name}: year, cold"), |b| {
             b.iter(|| year(&LightModel::precompute(scene.clone(), LightSettings::default()).unwrap(), &weather, None))
         });
