@@ -541,6 +541,10 @@ fn annual_refuses_bad_weather_and_scenes_without_sensors_in_one_line() {
         heliodon(&["annual", room.to_str().unwrap(), "--weather", full.to_str().unwrap(), "--occupied", "18:00-08:00"], &scratch());
     assert_eq!(code, 2);
     assert!(err.contains("--occupied") && err.contains("the end is not after the start"), "{err}");
+    let Run { code, err, .. } =
+        heliodon(&["annual", room.to_str().unwrap(), "--weather", full.to_str().unwrap(), "--occupied", "08:00-08:30"], &scratch());
+    assert_eq!(code, 2);
+    assert!(err.contains("--occupied") && err.contains("holds no hour"), "{err}");
     // The hourly file is opened before the year is read: a folder that is not there fails at once.
     let nowhere = dir.join("no-such-folder").join("hourly.csv");
     let Run { code, err, .. } = heliodon(

@@ -91,7 +91,8 @@ impl Default for Occupancy {
 }
 
 impl Occupancy {
-    /// Parses `HH:MM-HH:MM` (the end after the start).
+    /// Parses `HH:MM-HH:MM` (the end after the start, holding the middle of
+    /// at least one hour: a year of no occupied hour would read 0 everywhere).
     pub fn parse(text: &str) -> Result<Self, String> {
         let (start, end) = text.split_once('-').ok_or_else(|| format!("'{text}' is not HH:MM-HH:MM"))?;
         let start = TimeOfDay::parse(start)?.hours();
@@ -99,7 +100,13 @@ impl Occupancy {
         if end <= start {
             return Err(format!("'{text}': the end is not after the start"));
         }
-        Ok(Self { start, end })
+        let occupancy = Self { start, end };
+        if !(1..=24).any(|hour| occupancy.contains(hour)) {
+            return Err(format!(
+                "'{text}' holds no hour: an EPW hour is occupied when its middle (08:30 for the hour ending 09:00) lies in the range, its start included and its end not"
+            ));
+        }
+        Ok(occupancy)
     }
 
     /// Whether EPW hour `hour` (1-24, ending at `hour`) is occupied.
@@ -601,6 +608,8 @@ mod tests {
         let evening = Occupancy::parse("17:00-21:30").unwrap();
         assert_eq!((1..=24).filter(|&h| evening.contains(h)).collect::<Vec<_>>(), vec![18, 19, 20, 21]);
         assert!(Occupancy::parse("18:00-08:00").is_err());
+        assert!(Occupancy::parse("08:00-08:30").is_err_and(|e| e.contains("holds no hour")));
+        assert_eq!((1..=24).filter(|&h| Occupancy::parse("08:00-08:31").unwrap().contains(h)).collect::<Vec<_>>(), vec![9]);
         assert!(Occupancy::parse("8-18").is_err());
     }
 
