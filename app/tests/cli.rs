@@ -516,6 +516,11 @@ fn annual_hours_are_perez_skies_and_the_metrics_count_them() {
     }
 }
 
+/// Bad input to `annual` is one line and a non-zero exit, before the year
+/// is read: truncated or absent weather, a scene without sensors, an
+/// occupied range that is backwards or holds no hour, an `--hourly` file
+/// that cannot be made, shade groups that name the wrong materials. A
+/// scene of area sensors alone is no error, but has no sDA or ASE to give.
 #[test]
 fn annual_refuses_bad_weather_and_scenes_without_sensors_in_one_line() {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("annual_errors");
@@ -537,6 +542,13 @@ fn annual_refuses_bad_weather_and_scenes_without_sensors_in_one_line() {
     let Run { code, err, .. } = heliodon(&["annual", empty.scene().to_str().unwrap(), "--weather", full.to_str().unwrap()], &scratch());
     assert_eq!(code, 1);
     assert!(err.contains("the scene has no sensors"), "{err}");
+    // Area sensors only: sDA and ASE count point sensors, so the table says there are none rather than 0%.
+    let area = "[[sensors]]\nname = \"patch\"\nposition = [0.5, 0.5, 0.5]\nnormal = [0.0, 0.0, 1.0]\nsize = 0.5\n";
+    let area_only = fixture("annual_area_sensors", &scene_toml(area), OBJ);
+    let Run { code, out, err } =
+        heliodon(&["annual", area_only.scene().to_str().unwrap(), "--weather", full.to_str().unwrap()], &scratch());
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("sDA300/50%, ASE1000/250: none (they count point sensors") && !out.contains("% of"), "{out}");
     let Run { code, err, .. } =
         heliodon(&["annual", room.to_str().unwrap(), "--weather", full.to_str().unwrap(), "--occupied", "18:00-08:00"], &scratch());
     assert_eq!(code, 2);

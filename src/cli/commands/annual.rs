@@ -209,8 +209,13 @@ fn report(result: &AnnualResult, format: Format, weather_path: &std::path::Path)
             if result.shaded_hours > 0 {
                 let _ = writeln!(out, "shades down in {} of them (IES LM-83)", result.shaded_hours);
             }
-            let _ = writeln!(out, "sDA300/50%  {:.1}% of sensors", result.sda());
-            let _ = writeln!(out, "ASE1000/250 {:.1}% of sensors", result.ase());
+            match result.sensors.iter().filter(|s| s.point).count() {
+                0 => out.push_str("sDA300/50%, ASE1000/250: none (they count point sensors; this scene has area sensors only)\n"),
+                points => {
+                    let _ = writeln!(out, "sDA300/50%  {:.1}% of {points} point sensors", result.sda());
+                    let _ = writeln!(out, "ASE1000/250 {:.1}% of {points} point sensors", result.ase());
+                }
+            }
             let _ = writeln!(out, "{:<20} {:>7} {:>8} {:>7} {:>9} {:>9}", "sensor", "DA300 %", "UDI<100", "UDI %", "UDI>3000", "ASE h");
             for s in &result.sensors {
                 let _ = writeln!(
