@@ -10,6 +10,7 @@
 pub mod args;
 pub mod commands;
 pub mod plot;
+pub mod sweep_table;
 
 use std::fmt;
 use std::path::PathBuf;

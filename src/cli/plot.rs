@@ -7,7 +7,7 @@ use std::path::Path;
 
 use image::{Rgb, RgbImage};
 
-use super::commands::sweep::{SDA_ROW, Table, best, key_value, scores};
+use super::sweep_table::{SDA_ROW, Table, best, key_value, scores};
 
 const WIDTH: u32 = 960;
 const HEIGHT: u32 = 720;
