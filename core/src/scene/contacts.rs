@@ -19,7 +19,7 @@ use std::collections::HashMap;
 use glam::{IVec3, Vec2, Vec3};
 
 use super::bounds;
-use super::patches::{CutPlane, IN_PLANE};
+use super::cut_plane::{CutPlane, IN_PLANE};
 use super::{Surface, Triangle};
 
 /// A surface takes at most this many contact planes (the longest contacts).

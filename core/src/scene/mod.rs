@@ -8,6 +8,7 @@
 //! [`save`] writes a scene's edits back into its file.
 
 mod contacts;
+mod cut_plane;
 mod error;
 mod file;
 mod frame;
@@ -29,10 +30,11 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
+pub use cut_plane::CutPlane;
 pub use error::{Location, SceneError, SceneWarning, line_of};
 pub use frame::{ModelFrame, UpAxis};
 pub use material::{Material, MaterialKind, MaterialOrigin, Rgb};
-pub use patches::{CutPlane, Patch, PatchMesh, PatchSizing};
+pub use patches::{Patch, PatchMesh, PatchSizing};
 pub use sensors::{DEFAULT_FOV, Sensor, Viewpoint};
 pub use shades::ShadeGroup;
 
