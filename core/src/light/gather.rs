@@ -14,7 +14,7 @@ use glam::DVec3;
 
 use super::bvh::Tracer;
 use super::landings::Landings;
-use super::sampling::{self, Rng, cosine_directions, point_on_triangle};
+use super::sampling::{self, Rng, cosine_directions, sample_area, with_cumulative_areas};
 use super::{LightModel, LightSettings, MAX_GLASS_DEPTH, MIN_WEIGHT, SURFACE_OFFSET, Surface, par_map};
 use crate::scene::{Scene, Sensor};
 
@@ -518,24 +518,4 @@ fn place_sensor(tracer: &Tracer, sensor: &Sensor, n: usize) -> Vec<DVec3> {
 pub fn sensor_points(scene: &Scene) -> Vec<Vec<DVec3>> {
     let tracer = Tracer::new(&scene.patches);
     scene.sensors.iter().map(|s| place_sensor(&tracer, s, 4)).collect()
-}
-
-/// Triangles with the running total of their areas, for [`sample_area`].
-pub(super) fn with_cumulative_areas(triangles: impl Iterator<Item = [glam::Vec3; 3]>) -> Vec<([DVec3; 3], f64)> {
-    let mut total = 0.0;
-    triangles
-        .map(|t| {
-            let t = t.map(|v| v.as_dvec3());
-            total += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
-            (t, total)
-        })
-        .collect()
-}
-
-/// A uniformly distributed point on triangles given with cumulative areas.
-pub(super) fn sample_area(triangles: &[([DVec3; 3], f64)], rng: &mut Rng) -> DVec3 {
-    let total = triangles.last().map_or(0.0, |t| t.1);
-    let pick = rng.next_f64() * total;
-    let index = triangles.partition_point(|t| t.1 < pick).min(triangles.len() - 1);
-    point_on_triangle(&triangles[index].0, rng.next_f64(), rng.next_f64())
 }

@@ -9,8 +9,7 @@ use std::sync::{Arc, OnceLock};
 
 use glam::DVec3;
 
-use super::gather::{sample_area, with_cumulative_areas};
-use super::sampling::Rng;
+use super::sampling::{Rng, sample_area, with_cumulative_areas};
 use super::windows::WindowGroups;
 use super::{LightModel, SURFACE_OFFSET};
 use crate::panel::{Lobe, PanelModel};

@@ -63,6 +63,26 @@ pub fn point_on_triangle(t: &[DVec3; 3], a: f64, b: f64) -> DVec3 {
     t[0] * (1.0 - s) + t[1] * (s * (1.0 - b)) + t[2] * (s * b)
 }
 
+/// Triangles with the running total of their areas, for [`sample_area`].
+pub fn with_cumulative_areas(triangles: impl Iterator<Item = [glam::Vec3; 3]>) -> Vec<([DVec3; 3], f64)> {
+    let mut total = 0.0;
+    triangles
+        .map(|t| {
+            let t = t.map(|v| v.as_dvec3());
+            total += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+            (t, total)
+        })
+        .collect()
+}
+
+/// A uniformly distributed point on triangles given with cumulative areas.
+pub fn sample_area(triangles: &[([DVec3; 3], f64)], rng: &mut Rng) -> DVec3 {
+    let total = triangles.last().map_or(0.0, |t| t.1);
+    let pick = rng.next_f64() * total;
+    let index = triangles.partition_point(|t| t.1 < pick).min(triangles.len() - 1);
+    point_on_triangle(&triangles[index].0, rng.next_f64(), rng.next_f64())
+}
+
 /// The solid angle (sr) triangle `t` fills seen from `eye` (Van Oosterom
 /// and Strackee 1983), whichever side it is seen from.
 pub fn solid_angle(eye: DVec3, t: &[DVec3; 3]) -> f64 {

@@ -6,11 +6,10 @@
 
 use glam::DVec3;
 
-use super::gather::sample_area;
 use super::measured::MeasuredSun;
 use super::openings::WayIn;
 use super::panels::{self, SunBeam};
-use super::sampling::Rng;
+use super::sampling::{Rng, sample_area};
 use super::{LightModel, SURFACE_OFFSET, Surface, par_map};
 use crate::sky::SunSource;
 
