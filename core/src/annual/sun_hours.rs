@@ -108,7 +108,7 @@ impl SunHours {
         progress: &(dyn Fn(f64) + Sync),
     ) -> Option<(Self, CacheOutcome)> {
         let shade_groups = if shades { model.scene.shades.len() } else { 0 };
-        let row_bytes = model.scene.sensors.len() * (2 + shade_groups) * size_of::<f32>();
+        let row_bytes = row_bytes(model.scene.sensors.len(), shade_groups);
         let fits = |suns: &[Option<Option<DVec3>>]| suns.iter().flatten().flatten().count() * row_bytes <= MAX_TABLE_BYTES;
         let ours = sun_directions(site, hours);
         if !fits(&ours) {
@@ -199,12 +199,7 @@ impl SunHours {
 
     /// How many rows the file holds.
     fn rows(&self) -> usize {
-        ((self.file.len() - ROWS_AT) / self.row_bytes() as u64) as usize
-    }
-
-    /// Bytes of one hour's row.
-    fn row_bytes(&self) -> usize {
-        (2 + self.shade_groups) * self.sensors * size_of::<f32>()
+        ((self.file.len() - ROWS_AT) / row_bytes(self.sensors, self.shade_groups) as u64) as usize
     }
 
     /// Appends every row of the file to `out`, a piece at a time.
@@ -239,8 +234,13 @@ impl SunHours {
                 _ => None,
             })
             .collect::<Option<Vec<_>>>()?;
-        let row_bytes = (2 + shade_groups) * sensors * size_of::<f32>();
-        (file.len() == ROWS_AT + (row_count * row_bytes) as u64).then_some(Self { key, sensors, shade_groups, row_of_hour, file })
+        (file.len() == ROWS_AT + (row_count * row_bytes(sensors, shade_groups)) as u64).then_some(Self {
+            key,
+            sensors,
+            shade_groups,
+            row_of_hour,
+            file,
+        })
     }
 
     /// What the table depends on: the scene's precomputation
@@ -304,12 +304,17 @@ impl SunHours {
             Some(HourRow::SunDown) => return Ok(None),
             Some(HourRow::NotTraced) | None => return Err(not_traced(k)),
         };
-        let row_values = (2 + self.shade_groups) * self.sensors;
-        let offset = ROWS_AT + ((row as usize * row_values + range.start) * size_of::<f32>()) as u64;
+        let offset = ROWS_AT + (row as usize * row_bytes(self.sensors, self.shade_groups) + range.start * size_of::<f32>()) as u64;
         let mut bytes = vec![0u8; range.len() * size_of::<f32>()];
         self.file.read_at(offset, &mut bytes).map_err(|e| format!("cannot read the year's sun from the light cache: {e}"))?;
         Ok(Some(bytes.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes"))).collect()))
     }
+}
+
+/// Bytes of one hour's row: each sensor's direct and interreflected sun,
+/// then its direct sun through each of `shade_groups` groups' windows.
+fn row_bytes(sensors: usize, shade_groups: usize) -> usize {
+    (2 + shade_groups) * sensors * size_of::<f32>()
 }
 
 /// Where a year's hours get their sun: the cached table, or traced hour by

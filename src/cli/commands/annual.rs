@@ -3,8 +3,9 @@
 
 use std::fmt::Write as _;
 use std::fs::File;
-use std::io::Write as _;
+use std::io::{BufWriter, Write as _};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use crate::annual::{
     AnnualOptions, AnnualResult, HourlyReadings, Occupancy, ShadedModel, annual, missing_in_daylight_note, skipped_hours_note,
@@ -119,7 +120,9 @@ pub(crate) fn warn_about_skipped_hours(path: &Path, skipped: Option<&(usize, Str
 /// every sensor's total lux.
 struct HourlyCsv<'w> {
     path: PathBuf,
-    out: std::sync::Mutex<std::io::BufWriter<std::fs::File>>,
+    /// Behind a lock only because the year's callback must be `Sync`: it
+    /// is called from one thread, in order.
+    out: Mutex<BufWriter<File>>,
     weather: &'w Weather,
 }
 
@@ -134,7 +137,7 @@ impl<'w> HourlyCsv<'w> {
         header.push('\n');
         let csv = Self {
             path: path.to_path_buf(),
-            out: std::sync::Mutex::new(std::io::BufWriter::new(File::create(path).map_err(|e| Self::why(path, e))?)),
+            out: Mutex::new(BufWriter::new(File::create(path).map_err(|e| Self::why(path, e))?)),
             weather,
         };
         csv.write(header.as_bytes())?;
