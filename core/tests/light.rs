@@ -980,7 +980,8 @@ fn a_windowless_room_is_dark_though_its_floor_runs_on_outside() {
 
 /// The automatic first view looks into one room through its windows, even
 /// when one façade's windows (one window group) light several rooms: the
-/// eye is not put at the partition between them.
+/// eye is not put at the partition between them; and with a column between
+/// its corner and the window it moves to where it sees the window.
 #[test]
 fn the_first_view_looks_into_one_room() {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("two_rooms");
@@ -1016,6 +1017,25 @@ fn the_first_view_looks_into_one_room() {
     assert!((view.eye.x - 4.0).abs() > 0.3, "the eye stands at the partition: {}", view.eye);
     assert_eq!(room(view.eye.x), room(view.target.x), "the eye looks into the other room: {} → {}", view.eye, view.target);
     assert!((view.target.x - 2.0).abs() < 0.1 || (view.target.x - 6.0).abs() < 0.1, "the target is one room's window: {}", view.target);
+
+    // A column between that corner and the window: the eye moves to where it sees the window.
+    let middle = ((view.eye + view.target) * 0.5).as_dvec3();
+    let (x0, x1, y0, y1) = (middle.x - 0.2, middle.x + 0.2, middle.y - 0.2, middle.y + 0.2);
+    obj.quad("wall", [[x0, y0, 0.0], [x1, y0, 0.0], [x1, y0, h], [x0, y0, h]]);
+    obj.quad("wall", [[x1, y0, 0.0], [x1, y1, 0.0], [x1, y1, h], [x1, y0, h]]);
+    obj.quad("wall", [[x1, y1, 0.0], [x0, y1, 0.0], [x0, y1, h], [x1, y1, h]]);
+    obj.quad("wall", [[x0, y1, 0.0], [x0, y0, 0.0], [x0, y0, h], [x0, y1, h]]);
+    std::fs::write(dir.join("room.obj"), obj.text()).unwrap();
+    let model = LightModel::unlit(load(&dir.join("scene.toml")));
+    let sight = |eye: glam::Vec3, target: glam::Vec3| {
+        let clear = model.trace(eye.as_dvec3(), (target - eye).normalize().as_dvec3()).map_or(f64::INFINITY, |(_, d)| d);
+        clear / f64::from(eye.distance(target))
+    };
+    assert!(sight(view.eye, view.target) < 0.6, "the column stands between the old eye and the window");
+    let moved = model.interior_view().unwrap();
+    println!("eye {}, target {}", moved.eye, moved.target);
+    assert!(sight(moved.eye, moved.target) >= 0.9, "the eye sees the window: {} → {}", moved.eye, moved.target);
+    assert!((moved.eye.x - 4.0).abs() > 0.3 && room(moved.eye.x) == room(moved.target.x), "{} → {}", moved.eye, moved.target);
 }
 
 /// A panel as a modder would write one, for the lobe coefficients' test: a

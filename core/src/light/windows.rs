@@ -116,7 +116,9 @@ impl super::LightModel {
     /// looking out through them: the eye at eye height in the back corner
     /// (toward the far wall, then toward a side wall), looking at the
     /// windows' middle a metre above the floor, so the floor's sun patches
-    /// and the windows are both in view. `None` without vertical windows
+    /// and the windows are both in view. Where something stands between
+    /// that corner and the windows (a stair, a column), the other back
+    /// corner, then places nearer the windows, are tried for a clear sight. `None` without vertical windows
     /// that see the sky.
     pub fn interior_view(&self) -> Option<crate::scene::Viewpoint> {
         let scene = &self.scene;
@@ -137,11 +139,30 @@ impl super::LightModel {
         let reach = |from: glam::Vec3, direction: glam::Vec3, fallback: f32| {
             self.trace(from.as_dvec3(), direction.as_dvec3()).map_or(fallback, |(_, d)| d as f32)
         };
-        let mut eye = centre + inward * (0.85 * reach(centre + inward * 0.05, inward, 5.0));
-        eye += across * (0.6 * reach(eye, across, 2.0));
-        let floor = eye.z - reach(eye, glam::Vec3::NEG_Z, EYE_HEIGHT);
-        eye.z = floor + EYE_HEIGHT;
-        let target = glam::Vec3::new(centre.x, centre.y, floor + 1.0);
+        let depth = reach(centre + inward * 0.05, inward, 5.0);
+        // The eye `back` of the room's depth in from the windows, toward the
+        // side wall along `side`; and the target it looks at.
+        let place = |back: f32, side: glam::Vec3| {
+            let mut eye = centre + inward * (back * depth);
+            if side != glam::Vec3::ZERO {
+                eye += side * (0.6 * reach(eye, side, 2.0));
+            }
+            let floor = eye.z - reach(eye, glam::Vec3::NEG_Z, EYE_HEIGHT);
+            eye.z = floor + EYE_HEIGHT;
+            (eye, glam::Vec3::new(centre.x, centre.y, floor + 1.0))
+        };
+        // Nothing (a stair, a column, a wardrobe) between the eye and the windows.
+        let sees_windows = |(eye, target): &(glam::Vec3, glam::Vec3)| {
+            reach(*eye, (*target - *eye).normalize_or_zero(), f32::INFINITY) >= 0.9 * eye.distance(*target)
+        };
+        // The back corner, then the other back corner, then nearer the windows.
+        let places = [(0.85, across), (0.85, -across), (0.6, across), (0.6, -across), (0.4, glam::Vec3::ZERO)];
+        let first = place(places[0].0, places[0].1);
+        let (eye, target) = if sees_windows(&first) {
+            first
+        } else {
+            places[1..].iter().map(|&(back, side)| place(back, side)).find(sees_windows).unwrap_or(first)
+        };
         Some(crate::scene::Viewpoint { name: "inside".into(), eye, target, fov: crate::scene::DEFAULT_FOV })
     }
 
