@@ -421,7 +421,7 @@ impl SweptYear {
             Some((sun, table.sunlit(model, sun), rest))
         });
         model.set_panel_model(variation.material, panel.0.clone());
-        let skies = skies.clone().beside_panels(model, coefficients, table.groups());
+        let skies = skies.clone().beside_panels(model, &coefficients.totals(model), table.groups());
         Some(Self { skies, hours, table })
     }
 

@@ -1144,22 +1144,27 @@ fn lobe_coefficients_read_what_tracing_reads() {
         skies.iter().flat_map(|sky| model.sun_beams(&heliodon_core::sky::SunSource::unit(sky.sun.unwrap().direction))).collect();
     table.trace(&model, &coefficients, &beams, None);
     let (mut errors, mut in_part_shade) = (Vec::new(), 0);
+    let totals = coefficients.totals(&model);
     for ((sky, &sun), rest) in skies.iter().zip(&suns).zip(&rests) {
         let sunlit = table.sunlit(&model, sun);
         in_part_shade += usize::from(!sunlit.is_even());
         let traced = coefficients.readings(&model, sky, None);
         let beams = model.sun_beams(&heliodon_core::sky::SunSource::unit(sun));
         let response = coefficients.sun_response_with_lobes(&model, &beams, &table, &sunlit, rest, None);
-        let read = coefficients.readings_with_sun(&model, sky, Default::default(), Some(&response), None);
+        let read = coefficients.readings_with_sun(&model, sky, Some(&response), None);
         for (a, b) in traced.iter().zip(&read) {
             assert!((a.direct_sun - b.direct_sun).abs() <= 1e-6 * a.direct_sun.max(1.0), "{} against {}", b.direct_sun, a.direct_sun);
             errors.push((b.total - a.total).abs() / a.total);
         }
-        // The sky light beside the panel, kept, reads as the whole sky read again (to f32 rounding).
-        let beside = coefficients.sky_beside_panels(&model, sky, None, table.groups());
+        // The direct light folded into the coefficients reads the same (to
+        // f32 rounding), and so does the sky light beside the panel, kept.
+        let folded = totals.readings(&model, sky, KnownSky::default(), Some(&response));
+        let beside = totals.sky_beside_panels(&model, sky, None, table.groups());
         let known = KnownSky { bins: None, beside_panels: Some(&beside) };
-        for (a, b) in read.iter().zip(coefficients.readings_with_sun(&model, sky, known, Some(&response), None)) {
-            assert!((a.total - b.total).abs() <= 1e-6 * a.total, "{}: {} beside the panel, {} whole", a.name, b.total, a.total);
+        for ((a, f), b) in read.iter().zip(&folded).zip(totals.readings(&model, sky, known, Some(&response))) {
+            assert!((a.total - f.total).abs() <= 1e-6 * a.total, "{}: {} folded, {} read", a.name, f.total, a.total);
+            assert!((a.direct_sun - f.direct_sun).abs() <= 1e-6 * a.direct_sun.max(1.0), "{}: {} folded", a.name, f.direct_sun);
+            assert!((f.total - b.total).abs() <= 1e-6 * f.total, "{}: {} beside the panel, {} whole", a.name, b.total, f.total);
         }
     }
     errors.sort_by(f64::total_cmp);

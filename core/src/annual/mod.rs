@@ -22,8 +22,9 @@
 //!    weather, and the light is linear in the sun's strength, so the table
 //!    is kept in the light cache for every weather file of the site whose
 //!    sunny hours it holds. A lit hour is then one product of the
-//!    coefficients with the hour's bin radiances plus the table's row times
-//!    the hour's direct normal irradiance: no ray, no radiosity solve. Runs of whole days go in
+//!    coefficients, the direct sky folded in ([`TotalCoefficients`]), with
+//!    the hour's bin radiances plus the table's row times the hour's direct
+//!    normal irradiance: no ray, no radiosity solve. Runs of whole days go in
 //!    parallel; hours are independent, so the numbers do not depend on the
 //!    thread count; occupied hours are counted as they come (the others
 //!    are not read unless every hour is kept). The table (sensors × traced
@@ -52,7 +53,7 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use crate::light::coefficients::SunResponse;
-use crate::light::{KnownSky, LightModel, SensorCoefficients, SkyBesidePanels, SunPath, par_map};
+use crate::light::{KnownSky, LightModel, SensorCoefficients, SkyBesidePanels, SunPath, TotalCoefficients, par_map};
 use crate::site::Site;
 use crate::sky::{Sky, SkyError, SkySpec, perez, sky_at};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
@@ -368,13 +369,13 @@ impl YearSkies {
     }
 
     /// Keeps every lit hour's sky light beside the panels of `groups`
-    /// ([`SensorCoefficients::sky_beside_panels`]), for studies on models
+    /// ([`TotalCoefficients::sky_beside_panels`]), for studies on models
     /// that differ from `model` only in those panels: they read only what
     /// the panels pass.
-    pub fn beside_panels(mut self, model: &LightModel, coefficients: &SensorCoefficients, groups: &[u32]) -> Self {
+    pub fn beside_panels(mut self, model: &LightModel, totals: &TotalCoefficients, groups: &[u32]) -> Self {
         self.beside = par_map(None, HOURS, |k| {
             let sky = self.sky(k)?;
-            Some(coefficients.sky_beside_panels(model, sky, self.bins.get(k).and_then(Option::as_deref), groups))
+            Some(totals.sky_beside_panels(model, sky, self.bins.get(k).and_then(Option::as_deref), groups))
         });
         self
     }
@@ -512,13 +513,14 @@ pub fn annual(
         })
         .collect();
 
+    let totals = coefficients.totals(model);
     let days = HOURS / 24;
     // (total with the hour's shades, direct sun with every shade up) per
     // sensor; `None` when the hour is dark.
     let readings = |k: usize| -> Result<Option<Vec<(f64, f64)>>, String> {
         let Some(sky) = lit(k) else { return Ok(None) };
         let sun = if with_sun[k] { year_sun.response(k)? } else { None };
-        let open = coefficients.readings_with_sun(model, sky, year_skies.known(k), sun.as_ref(), Some(1));
+        let open = totals.readings(model, sky, year_skies.known(k), sun.as_ref());
         Ok(Some(match shaded.iter().find(|(mask, ..)| *mask == down[k]) {
             Some((_, shaded_model, coefficients, path)) => {
                 let lowered = coefficients.readings_on_path(shaded_model, sky, path, Some(1));

@@ -61,10 +61,10 @@ const MAX_CACHED_BYTES: usize = 256 << 20;
 /// long as the panels reflect the room's light back as before
 /// ([`LightModel::panel_back_reflectance`]).
 pub struct SensorCoefficients {
-    sensors: usize,
-    slots: RadianceSlots,
+    pub(super) sensors: usize,
+    pub(super) slots: RadianceSlots,
     /// Interreflected lux per unit radiance (W/m²/sr) of each slot, `[slot][sensor]`.
-    sky: Vec<f32>,
+    pub(super) sky: Vec<f32>,
     /// Interreflected lux per W/m² of sun beams on each side, beyond the
     /// first bounce, `[side][sensor]`.
     sun: Vec<f32>,
@@ -253,27 +253,6 @@ pub struct SunResponse {
     pub interreflected: Vec<f32>,
 }
 
-/// What a caller reading one sky many times keeps of it.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct KnownSky<'a> {
-    /// Its [`LightModel::sphere_bins`].
-    pub bins: Option<&'a [f64]>,
-    /// Its light beside some panels ([`SensorCoefficients::sky_beside_panels`]):
-    /// only what they pass is read.
-    pub beside_panels: Option<&'a SkyBesidePanels>,
-}
-
-/// Every sensor's sky light (lux) that passes no panel of some groups
-/// ([`SensorCoefficients::sky_beside_panels`]).
-#[derive(Debug, Clone)]
-pub struct SkyBesidePanels {
-    groups: Vec<u32>,
-    /// Interreflected, from every radiance slot but those groups'.
-    interreflected: Vec<f32>,
-    /// Direct, by every gather key but those through those groups' windows.
-    direct: Vec<f32>,
-}
-
 /// The sun's light at every sensor, lux: straight (beams and lobes, not
 /// what panels diffuse) and interreflected.
 struct SunLux {
@@ -322,7 +301,7 @@ impl SensorCoefficients {
         let measured = model.measured_sun(&beams);
         let direct = par_map(threads, model.sensors.len(), |i| model.sensor_direct_sun(i, &beams, &measured) * LUMINOUS_EFFICACY);
         let sun = SunLux { direct, interreflected: self.interreflected_sun(model, &beams, threads) };
-        self.read(model, model.key_radiance(sky), sun, None, threads)
+        self.read(model, model.key_radiance(sky), sun, threads)
     }
 
     /// [`Self::readings`] with the sun's light beyond its first bounce read
@@ -330,17 +309,16 @@ impl SensorCoefficients {
     /// bounce where the sensors' rays land are still traced.
     pub fn readings_on_path(&self, model: &LightModel, sky: &Sky, path: &SunPath, threads: Option<usize>) -> Vec<SensorReading> {
         let response = sky.sun_up().map(|s| self.sun_response(model, s.direction, path, threads));
-        self.readings_with_sun(model, sky, KnownSky::default(), response.as_ref(), threads)
+        self.readings_with_sun(model, sky, response.as_ref(), threads)
     }
 
     /// The readings under `sky` with the sun's light from `response` (its
     /// sun's direction; `None` when the sun is down), scaled by the sky's
-    /// sun: no ray is traced. `known`: what the caller keeps of the sky.
+    /// sun: no ray is traced.
     pub fn readings_with_sun(
         &self,
         model: &LightModel,
         sky: &Sky,
-        known: KnownSky,
         response: Option<&SunResponse>,
         threads: Option<usize>,
     ) -> Vec<SensorReading> {
@@ -351,23 +329,7 @@ impl SensorCoefficients {
             _ => vec![0.0; count],
         };
         let sun = SunLux { direct: scaled(response.map(|r| &r.direct)), interreflected: scaled(response.map(|r| &r.interreflected)) };
-        let seen = model.key_radiance_in(sky, known.bins);
-        self.read(model, seen, sun, known.beside_panels, threads)
-    }
-
-    /// Every sensor's sky light (lux) that passes no panel of `groups`,
-    /// under `sky` (`bins`: its [`LightModel::sphere_bins`], when kept):
-    /// read once for a sky that models differing only in those panels read
-    /// again ([`KnownSky::beside_panels`]).
-    pub fn sky_beside_panels(&self, model: &LightModel, sky: &Sky, bins: Option<&[f64]>, groups: &[u32]) -> SkyBesidePanels {
-        let seen = model.key_radiance_in(sky, bins);
-        let beside = |group: Option<u32>| group.is_none_or(|g| !groups.contains(&g));
-        let mut interreflected = vec![0.0; self.sensors];
-        let radiance = seen.slots();
-        let slots = radiance.iter().zip(self.sky.chunks_exact(self.sensors.max(1))).enumerate();
-        add_products(&mut interreflected, slots.filter(|(slot, _)| beside(self.slots.group(*slot))).map(|(_, term)| term));
-        let direct = model.sensors.iter().map(|g| (seen.sky_irradiance_through(&g.gather, beside) * LUMINOUS_EFFICACY) as f32).collect();
-        SkyBesidePanels { groups: groups.to_vec(), interreflected: interreflected.iter().map(|&v| v as f32).collect(), direct }
+        self.read(model, model.key_radiance(sky), sun, threads)
     }
 
     /// The sun's light at every sensor for a sun of 1 W/m² normal
@@ -384,33 +346,17 @@ impl SensorCoefficients {
     }
 
     /// The readings with what the gather keys see (`seen`) and the sun's
-    /// light at every sensor given; with `beside`, the sky light beside its
-    /// panels is taken from it and only theirs is read.
-    fn read(
-        &self,
-        model: &LightModel,
-        seen: KeyRadiance,
-        sun: SunLux,
-        beside: Option<&SkyBesidePanels>,
-        threads: Option<usize>,
-    ) -> Vec<SensorReading> {
+    /// light at every sensor given.
+    fn read(&self, model: &LightModel, seen: KeyRadiance, sun: SunLux, threads: Option<usize>) -> Vec<SensorReading> {
         let count = model.sensors.len();
         let mut indirect = sun.interreflected;
         let slot_radiance = seen.slots();
         debug_assert_eq!(slot_radiance.len(), self.slots.len());
-        let products = slot_radiance.iter().zip(self.sky.chunks_exact(count.max(1))).enumerate();
-        let read_here = |group: Option<u32>| beside.is_none_or(|b| group.is_some_and(|g| b.groups.contains(&g)));
-        add_products(&mut indirect, products.filter(|(slot, _)| read_here(self.slots.group(*slot))).map(|(_, term)| term));
-        if let Some(beside) = beside {
-            indirect.iter_mut().zip(&beside.interreflected).for_each(|(e, &b)| *e += f64::from(b));
-        }
+        add_products(&mut indirect, slot_radiance.iter().zip(self.sky.chunks_exact(count.max(1))));
         par_map(threads, count, |i| {
             let geometry = &model.sensors[i];
             let direct_sun = seen.panel_sun_irradiance(&geometry.gather) * LUMINOUS_EFFICACY + sun.direct[i];
-            let direct_sky = match beside {
-                None => seen.sky_irradiance(&geometry.gather) * LUMINOUS_EFFICACY,
-                Some(beside) => f64::from(beside.direct[i]) + seen.sky_irradiance_through(&geometry.gather, read_here) * LUMINOUS_EFFICACY,
-            };
+            let direct_sky = seen.sky_irradiance(&geometry.gather) * LUMINOUS_EFFICACY;
             SensorReading::new(model.scene.sensors[i].name.clone(), direct_sun, direct_sky, indirect[i])
         })
     }

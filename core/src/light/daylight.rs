@@ -44,13 +44,6 @@ impl KeyRadiance {
         PI * gather.daylight_coefficients.iter().map(|&(k, w)| f64::from(w) * self.of(k)).sum::<f64>()
     }
 
-    /// [`Self::sky_irradiance`] of the keys whose panel group (`None`:
-    /// straight or through glass) `through` takes.
-    pub(super) fn sky_irradiance_through(&self, gather: &Gather, through: impl Fn(Option<u32>) -> bool) -> f64 {
-        let group = |k: u32| SkyKey::unpack(k, self.bin_count).window.and_then(|w| self.window_panel[w as usize]);
-        PI * gather.daylight_coefficients.iter().filter(|&&(k, _)| through(group(k))).map(|&(k, w)| f64::from(w) * self.of(k)).sum::<f64>()
-    }
-
     /// Sunlight that panels transmit diffusely (W/m²), seen through them.
     pub(super) fn panel_sun_irradiance(&self, gather: &Gather) -> f64 {
         // No panel diffuses sun (none in the scene, or no sun on them): the

@@ -44,13 +44,14 @@ mod sampling;
 pub mod settings;
 pub mod solver;
 pub mod sun;
+mod totals;
 pub mod windows;
 
 use std::sync::Arc;
 
 use glam::DVec3;
 
-pub use coefficients::{KnownSky, SensorCoefficients, SkyBesidePanels, SunPath};
+pub use coefficients::{SensorCoefficients, SunPath};
 pub use gather::{Gather, SkyKey, sensor_points, side_of};
 pub use glass::Glass;
 pub use lobe_table::{LOBE_STEP, LobeTable, Sunlit};
@@ -58,6 +59,7 @@ pub use measured::MeasuredSun;
 pub use panels::{LobeLook, PanelFrame, PanelLook, SunBeam};
 pub use settings::LightSettings;
 pub use solver::{Interreflection, Relight, form_factor_product};
+pub use totals::{HourLight, KnownSky, SkyBesidePanels, TotalCoefficients};
 pub use windows::{WindowGroup, WindowGroups};
 
 use crate::scene::{MaterialKind, Scene};

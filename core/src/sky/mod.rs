@@ -5,7 +5,9 @@
 //! Tregenza/Reinhart sky patches. Radiance units throughout: W/sr/m² of
 //! "visible watts", 179 lm/W. Plain Rust, no Bevy types.
 
+mod cells;
 pub mod cie;
+mod elementary;
 mod export;
 pub mod gensky;
 pub mod patches;
@@ -20,6 +22,7 @@ use crate::site::Site;
 use crate::sun::{SolarPosition, solar_position};
 use crate::time::LocalDateTime;
 
+pub use cells::SkyCells;
 pub use export::radiance_sky;
 pub use patches::SkyPatches;
 

@@ -9,7 +9,7 @@ use std::ops::Range;
 
 use glam::DVec3;
 
-use super::{Sky, SkyDirection};
+use super::{Sky, SkyCells};
 use crate::sun::direction_from_angles;
 
 /// Patches per Tregenza row, horizon first.
@@ -42,14 +42,10 @@ pub struct SkyPatches {
     /// toward east, the zenith cap last.
     pub patches: Vec<SkyPatch>,
     /// Quadrature directions above the horizon, and their mirrors below.
-    samples: Vec<SkyDirection>,
-    mirrored: Vec<SkyDirection>,
+    samples: SkyCells,
+    mirrored: SkyCells,
+    /// Each patch's cells, in both.
     sample_ranges: Vec<Range<u32>>,
-    /// The samples' heights (z), each once: a patch's cells lie in rows of
-    /// one height, and rows of patches share them.
-    heights: Vec<f64>,
-    /// Per sample, then per mirrored sample: its height's index.
-    height_of: Vec<u16>,
 }
 
 impl SkyPatches {
@@ -94,22 +90,9 @@ impl SkyPatches {
                 });
             }
         }
-        let mirrored: Vec<SkyDirection> = samples.iter().map(|d: &DVec3| SkyDirection::new(DVec3::new(d.x, d.y, -d.z))).collect();
-        let samples: Vec<SkyDirection> = samples.into_iter().map(SkyDirection::new).collect();
-        let mut heights: Vec<f64> = Vec::new();
-        let height_of = samples
-            .iter()
-            .chain(&mirrored)
-            .map(|d| {
-                // Cells of a row come together: the last height is the likely one.
-                let index = heights.iter().rposition(|&z| z.to_bits() == d.d.z.to_bits()).unwrap_or_else(|| {
-                    heights.push(d.d.z);
-                    heights.len() - 1
-                });
-                u16::try_from(index).expect("a few hundred heights")
-            })
-            .collect();
-        Self { subdivision: n, patches, samples, mirrored, sample_ranges, heights, height_of }
+        let mirrored = SkyCells::new(samples.iter().map(|d| DVec3::new(d.x, d.y, -d.z)));
+        let samples = SkyCells::new(samples);
+        Self { subdivision: n, patches, samples, mirrored, sample_ranges }
     }
 
     /// Number of patches: 144·n² + 1.
@@ -146,22 +129,19 @@ impl SkyPatches {
     /// Each patch's mean radiance under `sky` (sun excluded), into `out`.
     pub fn integrate_into(&self, sky: &Sky, out: &mut Vec<f64>) {
         out.clear();
-        self.extend_means(sky, false, &sky.height_terms(&self.heights), out);
+        self.extend_means(sky, &self.samples, out);
     }
 
-    /// Appends each patch's mean of `sky` over its cells, or over their
-    /// mirrors below the horizon; `height_terms`: [`Sky::height_terms`] of
-    /// the samples' heights.
-    fn extend_means(&self, sky: &Sky, mirrored: bool, height_terms: &[f64], out: &mut Vec<f64>) {
-        let (samples, height_of) = match mirrored {
-            false => (&self.samples, &self.height_of[..self.samples.len()]),
-            true => (&self.mirrored, &self.height_of[self.samples.len()..]),
-        };
-        out.extend(self.sample_ranges.iter().map(|range| {
-            let range = range.start as usize..range.end as usize;
-            let cells = samples[range.clone()].iter().zip(&height_of[range.clone()]);
-            cells.map(|(d, &h)| sky.radiance_toward(d, height_terms.get(usize::from(h)).copied())).sum::<f64>() / range.len() as f64
-        }));
+    /// Appends each patch's mean of `sky` over its cells in `cells` (the
+    /// samples or their mirrors below the horizon).
+    fn extend_means(&self, sky: &Sky, cells: &SkyCells, out: &mut Vec<f64>) {
+        let mut radiances = Vec::new();
+        sky.radiances_into(cells, &mut radiances);
+        out.extend(
+            self.sample_ranges
+                .iter()
+                .map(|range| radiances[range.start as usize..range.end as usize].iter().sum::<f64>() / range.len() as f64),
+        );
     }
 
     /// Each patch's mean radiance under `sky` (sun excluded).
@@ -181,10 +161,9 @@ impl SkyPatches {
 
     /// Mean radiance of every sphere bin ([`Self::sphere_bin`]) under `sky`, sun excluded.
     pub fn integrate_sphere_into(&self, sky: &Sky, out: &mut Vec<f64>) {
-        let height_terms = sky.height_terms(&self.heights);
         out.clear();
-        self.extend_means(sky, false, &height_terms, out);
-        self.extend_means(sky, true, &height_terms, out);
+        self.extend_means(sky, &self.samples, out);
+        self.extend_means(sky, &self.mirrored, out);
     }
 
     /// Total solid angle: 2π up to rounding.
@@ -210,26 +189,29 @@ mod tests {
         }
     }
 
-    /// A Perez sky's gradation, computed once per height of cells, gives
+    /// A Perez sky's radiance over the cells, its gradation computed once
+    /// per height of cells and the cells evaluated several lanes wide, gives
     /// every sphere bin's mean bit for bit as evaluating each cell alone;
     /// the quadrature's cells lie in a few rows of one height.
     #[test]
-    fn cells_of_one_height_share_the_perez_gradation() {
+    fn sphere_bins_are_the_means_of_each_cell_evaluated_alone() {
         let patches = SkyPatches::reinhart(4);
-        assert!(patches.heights.len() < 150, "{} heights", patches.heights.len());
+        assert!(patches.samples.height_count() + patches.mirrored.height_count() < 150);
         let input = crate::sky::perez::Input::Irradiance { direct_normal: 420.0, diffuse_horizontal: 180.0 };
-        let sky = Sky::new(&crate::sky::SkySpec::Perez(input), 23.0, 131.0, 0.2, 172).unwrap();
-        assert!(!sky.height_terms(&patches.heights).is_empty());
-        let mut bins = Vec::new();
-        patches.integrate_sphere_into(&sky, &mut bins);
-        let each_alone = |samples: &[SkyDirection]| -> Vec<f64> {
-            let mean =
-                |r: &Range<u32>| samples[r.start as usize..r.end as usize].iter().map(|d| sky.radiance(d.d)).sum::<f64>() / r.len() as f64;
-            patches.sample_ranges.iter().map(mean).collect()
-        };
-        let alone: Vec<f64> = each_alone(&patches.samples).into_iter().chain(each_alone(&patches.mirrored)).collect();
-        assert_eq!(bins.len(), 2 * patches.len());
-        assert!(bins.iter().zip(&alone).all(|(a, b)| a.to_bits() == b.to_bits()));
+        let perez = Sky::new(&crate::sky::SkySpec::Perez(input), 23.0, 131.0, 0.2, 172).unwrap();
+        let clear = Sky::new(&crate::sky::SkySpec::Clear { turbidity: 2.45 }, 23.0, 131.0, 0.2, 172).unwrap();
+        for sky in [perez, clear] {
+            let mut bins = Vec::new();
+            patches.integrate_sphere_into(&sky, &mut bins);
+            let each_alone = |cells: &SkyCells| -> Vec<f64> {
+                let radiances: Vec<f64> = cells.directions().map(|d| sky.radiance(d)).collect();
+                let mean = |r: &Range<u32>| radiances[r.start as usize..r.end as usize].iter().sum::<f64>() / r.len() as f64;
+                patches.sample_ranges.iter().map(mean).collect()
+            };
+            let alone: Vec<f64> = each_alone(&patches.samples).into_iter().chain(each_alone(&patches.mirrored)).collect();
+            assert_eq!(bins.len(), 2 * patches.len());
+            assert!(bins.iter().zip(&alone).all(|(a, b)| a.to_bits() == b.to_bits()));
+        }
     }
 
     #[test]

@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use super::{LUMINOUS_EFFICACY, SunSource};
+use super::{LUMINOUS_EFFICACY, SunSource, elementary};
 use crate::sun::direction_from_angles;
 
 /// gendaylit's sun: a disc 0.533° across.
@@ -229,9 +229,11 @@ fn gradation(c: &[f64; 5], cos_dzeta: f64) -> f64 {
 }
 
 /// The relative luminance's factor of the angle to the sun alone (Perez's
-/// indicatrix, 1 + c·exp(d·γ) + e·cos²γ).
+/// indicatrix, 1 + c·exp(d·γ) + e·cos²γ), the `exp` that a loop over
+/// cells runs several lanes wide.
+#[inline(always)]
 fn indicatrix(c: &[f64; 5], gamma: f64, cos_gamma: f64) -> f64 {
-    1.0 + c[2] * (c[3] * gamma).exp() + c[4] * cos_gamma * cos_gamma
+    1.0 + c[2] * elementary::exp(c[3] * gamma) + c[4] * cos_gamma * cos_gamma
 }
 
 /// gendaylit's normalisation integral: Σ lv·cos θ · 2π/145 over its 145
@@ -344,9 +346,10 @@ impl Perez {
     }
 
     /// [`Self::sky`] with the direction's [`Self::gradation`] known.
+    #[inline(always)]
     pub fn sky_with_gradation(&self, d: DVec3, gradation: f64) -> f64 {
         let cos_gamma = d.dot(self.sun).clamp(-1.0, 1.0);
-        self.normalisation * (gradation * indicatrix(&self.coefficients, cos_gamma.acos(), cos_gamma))
+        self.normalisation * (gradation * indicatrix(&self.coefficients, elementary::acos(cos_gamma), cos_gamma))
     }
 
     /// The sun direction the sky function uses (lowered to 87°).
