@@ -1098,7 +1098,7 @@ impl heliodon_core::panel::PanelModel for DarkModel {
 #[test]
 fn lobe_coefficients_read_what_tracing_reads() {
     use heliodon_core::annual::{hour_time, sun_direction};
-    use heliodon_core::light::{KnownSky, LobeTable, SunPath};
+    use heliodon_core::light::{HourSky, KnownSky, LobeTable, SunPath};
     use heliodon_core::weather::{HOURS, calendar};
     let dir = std::env::temp_dir().join(format!("heliodon-lobe-table-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -1158,10 +1158,11 @@ fn lobe_coefficients_read_what_tracing_reads() {
         }
         // The direct light folded into the coefficients reads the same (to
         // f32 rounding), and so does the sky light beside the panel, kept.
-        let folded = totals.readings(&model, sky, KnownSky::default(), Some(&response));
         let beside = totals.sky_beside_panels(&model, sky, None, table.groups());
-        let known = KnownSky { bins: None, beside_panels: Some(&beside) };
-        for ((a, f), b) in read.iter().zip(&folded).zip(totals.readings(&model, sky, known, Some(&response))) {
+        let whole = HourSky { sky, known: KnownSky::default(), response: Some(&response) };
+        let kept = HourSky { known: KnownSky { bins: None, beside_panels: Some(&beside) }, ..whole };
+        let [folded, kept] = <[_; 2]>::try_from(totals.readings_of_hours(&model, &[whole, kept])).unwrap();
+        for ((a, f), b) in read.iter().zip(&folded).zip(&kept) {
             assert!((a.total - f.total).abs() <= 1e-6 * a.total, "{}: {} folded, {} read", a.name, f.total, a.total);
             assert!((a.direct_sun - f.direct_sun).abs() <= 1e-6 * a.direct_sun.max(1.0), "{}: {} folded", a.name, f.direct_sun);
             assert!((f.total - b.total).abs() <= 1e-6 * f.total, "{}: {} beside the panel, {} whole", a.name, b.total, f.total);

@@ -53,7 +53,7 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use crate::light::coefficients::SunResponse;
-use crate::light::{KnownSky, LightModel, SensorCoefficients, SkyBesidePanels, SunPath, TotalCoefficients, par_map};
+use crate::light::{HourSky, KnownSky, LightModel, SensorCoefficients, SkyBesidePanels, SunPath, TotalCoefficients, par_map};
 use crate::site::Site;
 use crate::sky::{Sky, SkyError, SkySpec, perez, sky_at};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
@@ -515,29 +515,38 @@ pub fn annual(
 
     let totals = coefficients.totals(model);
     let days = HOURS / 24;
-    // (total with the hour's shades, direct sun with every shade up) per
-    // sensor; `None` when the hour is dark.
-    let readings = |k: usize| -> Result<Option<Vec<(f64, f64)>>, String> {
-        let Some(sky) = lit(k) else { return Ok(None) };
-        let sun = if with_sun[k] { year_sun.response(k)? } else { None };
-        let open = totals.readings(model, sky, year_skies.known(k), sun.as_ref());
-        Ok(Some(match shaded.iter().find(|(mask, ..)| *mask == down[k]) {
-            Some((_, shaded_model, coefficients, path)) => {
-                let lowered = coefficients.readings_on_path(shaded_model, sky, path, Some(1));
-                lowered.iter().zip(&open).map(|(l, o)| (l.total, o.direct_sun)).collect()
-            }
-            None => open.iter().map(|r| (r.total, r.direct_sun)).collect(),
-        }))
+    // A day's hours: per sensor (total with the hour's shades, direct sun
+    // with every shade up); `None` when the hour is dark or not read. The
+    // open room's hours are read together ([`TotalCoefficients::readings_of_hours`]).
+    type SensorsHour = Vec<(f64, f64)>;
+    let day_readings = |d: usize| -> Result<Vec<Option<SensorsHour>>, String> {
+        let read = |k: usize| hourly.is_some() || occupancy.contains(weather.hours[k].hour);
+        let lit_hours: Vec<(usize, &Sky)> = (d * 24..(d + 1) * 24).filter(|&k| read(k)).filter_map(|k| Some((k, lit(k)?))).collect();
+        let suns =
+            lit_hours.iter().map(|&(k, _)| if with_sun[k] { year_sun.response(k) } else { Ok(None) }).collect::<Result<Vec<_>, _>>()?;
+        let hours: Vec<HourSky> = (lit_hours.iter().zip(&suns))
+            .map(|(&(k, sky), sun)| HourSky { sky, known: year_skies.known(k), response: sun.as_ref() })
+            .collect();
+        let mut readings = vec![None; 24];
+        for ((k, sky), open) in lit_hours.into_iter().zip(totals.readings_of_hours(model, &hours)) {
+            readings[k - d * 24] = Some(match shaded.iter().find(|(mask, ..)| *mask == down[k]) {
+                Some((_, shaded_model, coefficients, path)) => {
+                    let lowered = coefficients.readings_on_path(shaded_model, sky, path, Some(1));
+                    lowered.iter().zip(&open).map(|(l, o)| (l.total, o.direct_sun)).collect()
+                }
+                None => open.iter().map(|r| (r.total, r.direct_sun)).collect(),
+            });
+        }
+        Ok(readings)
     };
     // One day: its tally of occupied hours and, when every hour is asked
     // for, its hours' totals.
     let day = |d: usize| -> Result<(Tally, Vec<Vec<f32>>), String> {
         let mut tally = Tally::new(sensor_count);
         let mut hours = Vec::new();
-        for (k, (hour, &lowered)) in weather.hours.iter().zip(&down).enumerate().skip(d * 24).take(24) {
-            let occupied = occupancy.contains(hour.hour);
-            let readings = if occupied || hourly.is_some() { readings(k)? } else { None };
-            if occupied {
+        let readings = day_readings(d)?;
+        for ((hour, &lowered), readings) in weather.hours.iter().zip(&down).skip(d * 24).take(24).zip(readings) {
+            if occupancy.contains(hour.hour) {
                 tally.count(readings.as_deref(), lowered != 0);
             }
             if hourly.is_some() {

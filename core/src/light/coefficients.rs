@@ -433,10 +433,44 @@ fn add_products_avx2<'r>(sum: &mut [f64], terms: impl Iterator<Item = (&'r f64, 
 #[inline(always)]
 fn add_products_each<'r>(sum: &mut [f64], terms: impl Iterator<Item = (&'r f64, &'r [f32])>) {
     for (&source, row) in terms {
-        if source != 0.0 {
-            for (e, &c) in sum.iter_mut().zip(row) {
-                *e += source * f64::from(c);
-            }
+        add_row(sum, source, row);
+    }
+}
+
+/// [`add_products`] into several sums at once, `sums[h] += Σ_slot
+/// sources[h][slot] · rows[slot]` (`rows` of `width` values each): each row
+/// is read once for every sum, and each sum is what [`add_products`] makes
+/// of it alone, bit for bit (the same order over slots).
+pub(super) fn add_products_together(sums: &mut [Vec<f64>], sources: &[Vec<f64>], rows: &[f32], width: usize) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2, checked just above.
+        return unsafe { add_products_together_avx2(sums, sources, rows, width) };
+    }
+    add_products_together_each(sums, sources, rows, width);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn add_products_together_avx2(sums: &mut [Vec<f64>], sources: &[Vec<f64>], rows: &[f32], width: usize) {
+    add_products_together_each(sums, sources, rows, width);
+}
+
+#[inline(always)]
+fn add_products_together_each(sums: &mut [Vec<f64>], sources: &[Vec<f64>], rows: &[f32], width: usize) {
+    for (slot, row) in rows.chunks_exact(width).enumerate() {
+        for (sum, source) in sums.iter_mut().zip(sources) {
+            add_row(sum, source[slot], row);
+        }
+    }
+}
+
+/// `sum += source · row`, skipped for a dark source.
+#[inline(always)]
+fn add_row(sum: &mut [f64], source: f64, row: &[f32]) {
+    if source != 0.0 {
+        for (e, &c) in sum.iter_mut().zip(row) {
+            *e += source * f64::from(c);
         }
     }
 }

@@ -59,7 +59,7 @@ pub use measured::MeasuredSun;
 pub use panels::{LobeLook, PanelFrame, PanelLook, SunBeam};
 pub use settings::LightSettings;
 pub use solver::{Interreflection, Relight, form_factor_product};
-pub use totals::{HourLight, KnownSky, SkyBesidePanels, TotalCoefficients};
+pub use totals::{HourLight, HourSky, KnownSky, SkyBesidePanels, TotalCoefficients};
 pub use windows::{WindowGroup, WindowGroups};
 
 use crate::scene::{MaterialKind, Scene};

@@ -12,7 +12,7 @@
 
 use std::f64::consts::PI;
 
-use super::coefficients::{SunResponse, add_products};
+use super::coefficients::{SunResponse, add_products, add_products_together};
 use super::daylight::RadianceSlots;
 use super::{LightModel, SensorCoefficients};
 use crate::sky::{LUMINOUS_EFFICACY, Sky};
@@ -46,6 +46,18 @@ pub struct KnownSky<'a> {
 pub struct SkyBesidePanels {
     groups: Vec<u32>,
     lux: Vec<f32>,
+}
+
+/// One hour a year reads ([`TotalCoefficients::readings_of_hours`]).
+#[derive(Debug, Clone, Copy)]
+pub struct HourSky<'a> {
+    /// The hour's sky.
+    pub sky: &'a Sky,
+    /// What the caller keeps of the sky.
+    pub known: KnownSky<'a>,
+    /// The sun's light at every sensor per W/m² of direct normal
+    /// irradiance from the hour's sun; `None` when the sun is down.
+    pub response: Option<&'a SunResponse>,
 }
 
 /// A sensor's light in one hour, lux.
@@ -89,34 +101,47 @@ impl SensorCoefficients {
 }
 
 impl TotalCoefficients {
-    /// Every sensor's light under `sky` with the sun's light from
-    /// `response` (its sun's direction; `None` when the sun is down),
-    /// scaled by the sky's sun: no ray is traced. `known`: what the caller
-    /// keeps of the sky.
-    pub fn readings(&self, model: &LightModel, sky: &Sky, known: KnownSky, response: Option<&SunResponse>) -> Vec<HourLight> {
-        let normal_irradiance = sky.sun_up().map_or(0.0, |s| s.normal_irradiance());
-        let scaled = |per_unit: Option<&Vec<f32>>| match per_unit {
-            Some(values) if normal_irradiance > 0.0 => values.iter().map(|&v| normal_irradiance * f64::from(v)).collect(),
-            _ => vec![0.0; self.sensors],
-        };
-        let radiance = model.key_radiance_in(sky, known.bins).slots();
+    /// Every sensor's light in each of `hours`, each hour's sun scaled by
+    /// its sky's sun: no ray is traced. The hours are read together, each
+    /// coefficient row fetched once for all of them (a row of the office is
+    /// 600 bytes, all of them 2.8 MB); every hour's sums are what it alone
+    /// would make, bit for bit.
+    pub fn readings_of_hours(&self, model: &LightModel, hours: &[HourSky]) -> Vec<Vec<HourLight>> {
+        let width = self.sensors.max(1);
         let first_panel_sun = self.slots.len() - model.panel_groups.len();
-        let straight = scaled(response.map(|r| &r.direct));
-        let mut direct_sun = straight.clone();
-        add_products(&mut direct_sun, radiance[first_panel_sun..].iter().zip(self.panel_sun.chunks_exact(self.sensors.max(1))));
-        // The products hold the direct sky and the panels' diffused sun; the beams and lobes are added.
-        let mut total = scaled(response.map(|r| &r.interreflected));
-        let rows = radiance.iter().zip(self.total.chunks_exact(self.sensors.max(1)));
-        match known.beside_panels {
-            None => add_products(&mut total, rows),
-            Some(beside) => {
-                total.iter_mut().zip(&beside.lux).for_each(|(e, &b)| *e += f64::from(b));
+        let mut sources = Vec::with_capacity(hours.len());
+        let mut straight = Vec::with_capacity(hours.len());
+        let mut direct_sun = Vec::with_capacity(hours.len());
+        let mut total = Vec::with_capacity(hours.len());
+        for hour in hours {
+            let normal_irradiance = hour.sky.sun_up().map_or(0.0, |s| s.normal_irradiance());
+            let scaled = |per_unit: Option<&Vec<f32>>| match per_unit {
+                Some(values) if normal_irradiance > 0.0 => values.iter().map(|&v| normal_irradiance * f64::from(v)).collect(),
+                _ => vec![0.0; self.sensors],
+            };
+            let mut radiance = model.key_radiance_in(hour.sky, hour.known.bins).slots();
+            let beams = scaled(hour.response.map(|r| &r.direct));
+            let mut sun = beams.clone();
+            add_products(&mut sun, radiance[first_panel_sun..].iter().zip(self.panel_sun.chunks_exact(width)));
+            let mut sum = scaled(hour.response.map(|r| &r.interreflected));
+            if let Some(beside) = hour.known.beside_panels {
+                // Kept: the slots beside the panels; read: theirs alone.
+                sum.iter_mut().zip(&beside.lux).for_each(|(e, &b)| *e += f64::from(b));
                 let through = |slot: usize| self.slots.group(slot).is_some_and(|g| beside.groups.contains(&g));
-                add_products(&mut total, rows.enumerate().filter(|(slot, _)| through(*slot)).map(|(_, term)| term));
+                radiance.iter_mut().enumerate().filter(|(slot, _)| !through(*slot)).for_each(|(_, r)| *r = 0.0);
             }
+            sources.push(radiance);
+            straight.push(beams);
+            direct_sun.push(sun);
+            total.push(sum);
         }
-        // + 0.0: a dark sensor reads 0, not −0.
-        (0..self.sensors).map(|i| HourLight { total: total[i] + straight[i] + 0.0, direct_sun: direct_sun[i] + 0.0 }).collect()
+        // The products hold the direct sky and the panels' diffused sun; the beams and lobes are added.
+        add_products_together(&mut total, &sources, &self.total, width);
+        let hour_light = |((total, straight), direct_sun): ((Vec<f64>, Vec<f64>), Vec<f64>)| {
+            // + 0.0: a dark sensor reads 0, not −0.
+            (0..self.sensors).map(|i| HourLight { total: total[i] + straight[i] + 0.0, direct_sun: direct_sun[i] + 0.0 }).collect()
+        };
+        total.into_iter().zip(straight).zip(direct_sun).map(hour_light).collect()
     }
 
     /// Every sensor's light under `sky` (`bins`: its
