@@ -22,6 +22,7 @@
 
 pub mod annual;
 pub mod day;
+mod lanes;
 pub mod light;
 pub mod panel;
 pub mod radiance;

@@ -411,30 +411,15 @@ impl SensorCoefficients {
 /// `sum` += Σ source × row, over (source, row of coefficients per sensor).
 ///
 /// A year reads every lit hour's sky through these products (4,610 rows
-/// of the office's 150 sensors an hour, most of a warm year): on a CPU with
-/// AVX2 the same loop runs four lanes wide. Each lane does the scalar's
-/// own multiply and add (no fused multiply-add), so the sums are the same
-/// bit for bit on any x86-64.
+/// of the office's 150 sensors an hour, a third of a warm year): the loop
+/// runs as wide as the CPU allows ([`crate::lanes`]), each lane the
+/// scalar's own multiply and add, so the sums are the same bit for bit on
+/// any x86-64.
 pub(super) fn add_products<'r>(sum: &mut [f64], terms: impl Iterator<Item = (&'r f64, &'r [f32])>) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU has AVX2, checked just above.
-        return unsafe { add_products_avx2(sum, terms) };
-    }
-    add_products_each(sum, terms);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn add_products_avx2<'r>(sum: &mut [f64], terms: impl Iterator<Item = (&'r f64, &'r [f32])>) {
-    add_products_each(sum, terms);
-}
-
-#[inline(always)]
-fn add_products_each<'r>(sum: &mut [f64], terms: impl Iterator<Item = (&'r f64, &'r [f32])>) {
-    for (&source, row) in terms {
-        add_row(sum, source, row);
-    }
+    crate::lanes::widest(
+        #[inline(always)]
+        || terms.for_each(|(&source, row)| add_row(sum, source, row)),
+    )
 }
 
 /// [`add_products`] into several sums at once, `sums[h] += Σ_slot
@@ -442,27 +427,16 @@ fn add_products_each<'r>(sum: &mut [f64], terms: impl Iterator<Item = (&'r f64, 
 /// is read once for every sum, and each sum is what [`add_products`] makes
 /// of it alone, bit for bit (the same order over slots).
 pub(super) fn add_products_together(sums: &mut [Vec<f64>], sources: &[Vec<f64>], rows: &[f32], width: usize) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU has AVX2, checked just above.
-        return unsafe { add_products_together_avx2(sums, sources, rows, width) };
-    }
-    add_products_together_each(sums, sources, rows, width);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn add_products_together_avx2(sums: &mut [Vec<f64>], sources: &[Vec<f64>], rows: &[f32], width: usize) {
-    add_products_together_each(sums, sources, rows, width);
-}
-
-#[inline(always)]
-fn add_products_together_each(sums: &mut [Vec<f64>], sources: &[Vec<f64>], rows: &[f32], width: usize) {
-    for (slot, row) in rows.chunks_exact(width).enumerate() {
-        for (sum, source) in sums.iter_mut().zip(sources) {
-            add_row(sum, source[slot], row);
-        }
-    }
+    crate::lanes::widest(
+        #[inline(always)]
+        || {
+            for (slot, row) in rows.chunks_exact(width).enumerate() {
+                for (sum, source) in sums.iter_mut().zip(sources) {
+                    add_row(sum, source[slot], row);
+                }
+            }
+        },
+    )
 }
 
 /// `sum += source · row`, skipped for a dark source.

@@ -1,8 +1,8 @@
 //! A quadrature's directions kept as columns, and a sky's radiance toward
 //! all of them in one call ([`Sky::radiances_into`]). An annual study
 //! integrates every lit hour's sky over some 15,000 cells of the sphere
-//! bins; for the Perez sky this runs four lanes wide on a CPU with AVX2
-//! (its `acos` and `exp` are branch-free, [`super::elementary`]) and gives
+//! bins; for the Perez sky this runs as wide as the CPU allows
+//! ([`crate::lanes`]: its `acos` and `exp` are branch-free, [`super::elementary`]) and gives
 //! the numbers [`Sky::radiance_toward`] gives each cell, bit for bit.
 
 use glam::DVec3;
@@ -97,27 +97,17 @@ impl Sky {
 }
 
 /// The Perez sky blended into the ground glow toward the first `out.len()`
-/// cells (their gradations given), as [`Sky::radiance_toward`] computes it.
+/// cells (their gradations given), as [`Sky::radiance_toward`] computes it,
+/// as many lanes wide as the CPU allows ([`crate::lanes`]).
 fn perez_radiances(perez: &Perez, cells: &SkyCells, gradations: &[f64], ground: f64, out: &mut [f64]) {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU has AVX2, checked just above.
-        return unsafe { perez_radiances_avx2(perez, cells, gradations, ground, out) };
-    }
-    perez_radiances_each(perez, cells, gradations, ground, out);
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn perez_radiances_avx2(perez: &Perez, cells: &SkyCells, gradations: &[f64], ground: f64, out: &mut [f64]) {
-    perez_radiances_each(perez, cells, gradations, ground, out);
-}
-
-#[inline(always)]
-fn perez_radiances_each(perez: &Perez, cells: &SkyCells, gradations: &[f64], ground: f64, out: &mut [f64]) {
-    let columns = cells.x.iter().zip(&cells.y).zip(&cells.z).zip(&cells.blend).zip(gradations);
-    for (radiance, ((((&x, &y), &z), &blend), &gradation)) in out.iter_mut().zip(columns) {
-        let sky = perez.sky_with_gradation(DVec3::new(x, y, z), gradation);
-        *radiance = if blend < NEGLIGIBLE_SKY_WEIGHT { ground } else { blend * sky + (1.0 - blend) * ground };
-    }
+    crate::lanes::widest(
+        #[inline(always)]
+        || {
+            let columns = cells.x.iter().zip(&cells.y).zip(&cells.z).zip(&cells.blend).zip(gradations);
+            for (radiance, ((((&x, &y), &z), &blend), &gradation)) in out.iter_mut().zip(columns) {
+                let sky = perez.sky_with_gradation(DVec3::new(x, y, z), gradation);
+                *radiance = if blend < NEGLIGIBLE_SKY_WEIGHT { ground } else { blend * sky + (1.0 - blend) * ground };
+            }
+        },
+    )
 }
