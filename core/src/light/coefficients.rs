@@ -255,9 +255,22 @@ pub struct SunResponse {
 
 /// The sun's light at every sensor, lux: straight (beams and lobes, not
 /// what panels diffuse) and interreflected.
-struct SunLux {
-    direct: Vec<f64>,
-    interreflected: Vec<f64>,
+pub(super) struct SunLux {
+    pub(super) direct: Vec<f64>,
+    pub(super) interreflected: Vec<f64>,
+}
+
+impl SunLux {
+    /// `response` (per W/m² of direct normal irradiance) scaled by `sky`'s
+    /// sun, for `count` sensors; 0 with the sun down or no response.
+    pub(super) fn scaled(response: Option<&SunResponse>, sky: &Sky, count: usize) -> Self {
+        let normal_irradiance = sky.sun_up().map_or(0.0, |s| s.normal_irradiance());
+        let scaled = |per_unit: Option<&Vec<f32>>| match per_unit {
+            Some(values) if normal_irradiance > 0.0 => values.iter().map(|&v| normal_irradiance * f64::from(v)).collect(),
+            _ => vec![0.0; count],
+        };
+        Self { direct: scaled(response.map(|r| &r.direct)), interreflected: scaled(response.map(|r| &r.interreflected)) }
+    }
 }
 
 impl SensorCoefficients {
@@ -322,13 +335,7 @@ impl SensorCoefficients {
         response: Option<&SunResponse>,
         threads: Option<usize>,
     ) -> Vec<SensorReading> {
-        let count = model.sensors.len();
-        let normal_irradiance = sky.sun_up().map_or(0.0, |s| s.normal_irradiance());
-        let scaled = |per_unit: Option<&Vec<f32>>| match per_unit {
-            Some(values) if normal_irradiance > 0.0 => values.iter().map(|&v| normal_irradiance * f64::from(v)).collect(),
-            _ => vec![0.0; count],
-        };
-        let sun = SunLux { direct: scaled(response.map(|r| &r.direct)), interreflected: scaled(response.map(|r| &r.interreflected)) };
+        let sun = SunLux::scaled(response, sky, model.sensors.len());
         self.read(model, model.key_radiance(sky), sun, threads)
     }
 

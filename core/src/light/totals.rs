@@ -12,7 +12,7 @@
 
 use std::f64::consts::PI;
 
-use super::coefficients::{SunResponse, add_products, add_products_together};
+use super::coefficients::{SunLux, SunResponse, add_products, add_products_together};
 use super::daylight::RadianceSlots;
 use super::{LightModel, SensorCoefficients};
 use crate::sky::{LUMINOUS_EFFICACY, Sky};
@@ -114,16 +114,10 @@ impl TotalCoefficients {
         let mut direct_sun = Vec::with_capacity(hours.len());
         let mut total = Vec::with_capacity(hours.len());
         for hour in hours {
-            let normal_irradiance = hour.sky.sun_up().map_or(0.0, |s| s.normal_irradiance());
-            let scaled = |per_unit: Option<&Vec<f32>>| match per_unit {
-                Some(values) if normal_irradiance > 0.0 => values.iter().map(|&v| normal_irradiance * f64::from(v)).collect(),
-                _ => vec![0.0; self.sensors],
-            };
+            let SunLux { direct: beams, interreflected: mut sum } = SunLux::scaled(hour.response, hour.sky, self.sensors);
             let mut radiance = model.key_radiance_in(hour.sky, hour.known.bins).slots();
-            let beams = scaled(hour.response.map(|r| &r.direct));
             let mut sun = beams.clone();
             add_products(&mut sun, radiance[first_panel_sun..].iter().zip(self.panel_sun.chunks_exact(width)));
-            let mut sum = scaled(hour.response.map(|r| &r.interreflected));
             if let Some(beside) = hour.known.beside_panels {
                 // Kept: the slots beside the panels; read: theirs alone.
                 sum.iter_mut().zip(&beside.lux).for_each(|(e, &b)| *e += f64::from(b));

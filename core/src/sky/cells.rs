@@ -12,7 +12,7 @@ use super::{Distribution, NEGLIGIBLE_SKY_WEIGHT, Sky, SkyDirection};
 
 /// Fixed directions a sky is evaluated toward many times.
 #[derive(Debug, Clone)]
-pub struct SkyCells {
+pub(super) struct SkyCells {
     directions: Vec<SkyDirection>,
     /// The directions' components and blend weights, as columns.
     x: Vec<f64>,
@@ -31,7 +31,7 @@ pub struct SkyCells {
 
 impl SkyCells {
     /// The cells of unit directions `directions`.
-    pub fn new(directions: impl IntoIterator<Item = DVec3>) -> Self {
+    pub(super) fn new(directions: impl IntoIterator<Item = DVec3>) -> Self {
         let directions: Vec<SkyDirection> = directions.into_iter().map(SkyDirection::new).collect();
         let column = |f: fn(&SkyDirection) -> f64| directions.iter().map(f).collect::<Vec<f64>>();
         let mut heights: Vec<f64> = Vec::new();
@@ -59,36 +59,28 @@ impl SkyCells {
         }
     }
 
-    /// How many directions.
-    pub fn len(&self) -> usize {
-        self.directions.len()
-    }
-
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.directions.is_empty()
-    }
-
     /// How many distinct heights the directions have.
-    pub fn height_count(&self) -> usize {
+    #[cfg(test)]
+    pub(super) fn height_count(&self) -> usize {
         self.heights.len()
     }
 
     /// The unit directions.
-    pub fn directions(&self) -> impl Iterator<Item = DVec3> + '_ {
+    #[cfg(test)]
+    pub(super) fn directions(&self) -> impl Iterator<Item = DVec3> + '_ {
         self.directions.iter().map(|d| d.d)
     }
 }
 
 impl Sky {
     /// [`Self::radiance_toward`] each of `cells`, into `out` (cleared first).
-    pub fn radiances_into(&self, cells: &SkyCells, out: &mut Vec<f64>) {
+    pub(super) fn radiances_into(&self, cells: &SkyCells, out: &mut Vec<f64>) {
         out.clear();
         match &self.distribution {
             Distribution::Perez(perez) => {
                 let by_height = self.height_terms(&cells.heights);
                 let gradations: Vec<f64> = cells.height_of[..cells.sky_end].iter().map(|&h| by_height[h as usize]).collect();
-                out.resize(cells.len(), self.ground_radiance);
+                out.resize(cells.directions.len(), self.ground_radiance);
                 perez_radiances(perez, cells, &gradations, self.ground_radiance, &mut out[..cells.sky_end]);
             }
             _ => out.extend(cells.directions.iter().map(|d| self.radiance_toward(d, None))),

@@ -22,7 +22,7 @@ use crate::site::Site;
 use crate::sun::{SolarPosition, solar_position};
 use crate::time::LocalDateTime;
 
-pub use cells::SkyCells;
+use cells::SkyCells;
 pub use export::radiance_sky;
 pub use patches::SkyPatches;
 
