@@ -43,7 +43,9 @@ def angle(parts):
     """IFC compound plane angle (degrees, minutes, seconds, millionths) to degrees."""
     if not parts:
         return None
-    sign = -1.0 if parts[0] < 0 else 1.0
+    # IFC gives every part the angle's sign, so a longitude of -0° 7' 34"
+    # has its sign in the minutes, not the degrees.
+    sign = -1.0 if any(p < 0 for p in parts) else 1.0
     values = [abs(p) for p in parts] + [0, 0, 0, 0]
     return sign * (values[0] + values[1] / 60 + values[2] / 3600 + values[3] / 3.6e9)
 
