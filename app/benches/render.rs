@@ -12,7 +12,10 @@
 //! on a GPU machine). `HELIODON_BENCH_SCENES` adds scene files (separated as
 //! in `PATH`, each named by its folder): real models, drawn in full from their
 //! first view. `HELIODON_BENCH_SECONDS` is each case's measurement time (15 s),
-//! shorter where device time is scarce.
+//! shorter where device time is scarce. `HELIODON_BENCH_GPU_TIMES=1` records
+//! the GPU's time per render pass (Bevy's and the sun pass's, that one per
+//! light too) and prints their means after each case, where the device has
+//! timestamp queries.
 
 #[path = "../../tests/support/office_floor.rs"]
 mod office_floor;
@@ -26,7 +29,9 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use heliodon::bevy::diagnostic::DiagnosticsStore;
 use heliodon::bevy::prelude::*;
+use heliodon::bevy::render::diagnostic::RenderDiagnosticsPlugin;
 use heliodon::bevy::render::render_resource::PollType;
 use heliodon::bevy::render::renderer::RenderDevice;
 use heliodon::ecs::{ActiveScene, SunSky};
@@ -47,6 +52,23 @@ fn frame_size() -> (u32, u32) {
         Some((w.trim().parse().ok()?, h.trim().parse().ok()?))
     });
     size.unwrap_or((1280, 720))
+}
+
+fn gpu_times() -> bool {
+    std::env::var_os("HELIODON_BENCH_GPU_TIMES").is_some()
+}
+
+/// The mean GPU time of each render pass and span over the last frames, and
+/// the sun pass's pipeline statistics (fragments shaded, primitives drawn).
+fn print_gpu_times(app: &App, label: &str) {
+    let store = app.world().resource::<DiagnosticsStore>();
+    let mut lines: Vec<String> = store
+        .iter()
+        .filter(|d| ["elapsed_gpu", "fragment_shader_invocations", "clipper_primitives_out"].iter().any(|f| d.path().as_str().ends_with(f)))
+        .filter_map(|d| Some(format!("  {} {:.3}", d.path().as_str(), d.average()?)))
+        .collect();
+    lines.sort();
+    println!("{label}: GPU time per pass (ms) and pipeline statistics, mean of the last frames\n{}", lines.join("\n"));
 }
 
 /// One frame drawn to the end: the app's update, then a wait until the
@@ -111,6 +133,9 @@ fn ready_app(scene: PathBuf, mode: RenderMode) -> (App, String) {
         panels: heliodon_app::builtin_panels(),
     };
     let mut app = offscreen_app(&request);
+    if gpu_times() {
+        app.add_plugins(RenderDiagnosticsPlugin);
+    }
     app.finish();
     app.cleanup();
     let start = std::time::Instant::now();
@@ -181,9 +206,20 @@ fn bench(c: &mut Criterion) {
         cases.push((format!("{} full", folder.unwrap_or_else(|| scene.display().to_string())), scene, RenderMode::Full));
     }
     for (label, scene, mode) in cases {
-        let (mut app, counts) = ready_app(scene, mode);
-        println!("{label}: {counts}");
-        group.bench_function(format!("frame {label} {width}x{height}"), |b| b.iter(|| draw(&mut app)));
+        // Loaded on the first call, so a case left out by the bench's
+        // filter loads nothing.
+        let mut ready: Option<App> = None;
+        group.bench_function(format!("frame {label} {width}x{height}"), |b| {
+            let app = ready.get_or_insert_with(|| {
+                let (app, counts) = ready_app(scene.clone(), mode);
+                println!("{label}: {counts}");
+                app
+            });
+            b.iter(|| draw(app))
+        });
+        if let Some(app) = ready.as_ref().filter(|_| gpu_times()) {
+            print_gpu_times(app, &label);
+        }
     }
     orbiting(&mut group);
     settling(&mut group);

@@ -6,6 +6,7 @@ use std::ops::Range;
 
 use bevy::prelude::*;
 use bevy::render::camera::ExtractedCamera;
+use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderContext, ViewQuery};
 use bevy::render::view::{ViewDepthTexture, ViewTarget, ViewUniformOffset, ViewUniforms};
@@ -45,6 +46,11 @@ pub(super) fn sun_pass(
     let depth_group =
         device.create_bind_group("heliodon_sun_depth", &layout(&pipelines.depth_layout), &BindGroupEntries::single(depth.view()));
 
+    // GPU time per pass, of the opaque volumes and of each light (its
+    // window's volume and its lit surfaces), where `RenderDiagnosticsPlugin`
+    // records them (the render bench's `HELIODON_BENCH_GPU_TIMES`).
+    let diagnostics = ctx.diagnostic_recorder();
+    let diagnostics = diagnostics.as_deref();
     let lit_vertices = (frame.surfaces.lit.len() / 9) as u32;
     let mut light_index = 0;
     for (pass_index, direction) in frame.passes.iter().enumerate() {
@@ -63,6 +69,7 @@ pub(super) fn sun_pass(
             occlusion_query_set: None,
             multiview_mask: None,
         });
+        let pass_span = diagnostics.pass_span(&mut pass, format!("heliodon_sun_pass {pass_index}"));
         if let Some(viewport) = camera.viewport.as_ref() {
             let (position, size) = (viewport.physical_position.as_vec2(), viewport.physical_size.as_vec2());
             pass.set_viewport(position.x, position.y, size.x, size.y, viewport.depth.start, viewport.depth.end);
@@ -102,21 +109,30 @@ pub(super) fn sun_pass(
                 }
             }};
         }
+        let span = diagnostics.time_span(&mut pass, "opaque volumes");
         draw_volumes!(count_caps, direction.opaque_caps.clone());
         draw_volumes!(count_volume, direction.opaque_sides.clone());
+        span.end(&mut pass);
         for light in &direction.lights {
+            let span = diagnostics.time_span(&mut pass, format!("light {light_index}"));
             match &light.aperture {
                 Some(aperture) => {
                     draw_volumes!(toggle_volume, aperture.clone());
+                    let lit_span = diagnostics.time_span(&mut pass, "lit");
                     draw_lit!(WINDOW_BIT, light.lit.as_ref());
+                    lit_span.end(&mut pass);
                     draw_volumes!(toggle_volume, aperture.clone());
                 }
                 None => {
                     draw_volumes!(count_volume, direction.all_windows.clone());
+                    let lit_span = diagnostics.time_span(&mut pass, "lit");
                     draw_lit!(0, light.lit.as_ref());
+                    lit_span.end(&mut pass);
                 }
             }
+            span.end(&mut pass);
             light_index += 1;
         }
+        pass_span.end(&mut pass);
     }
 }
