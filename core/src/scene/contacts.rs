@@ -296,7 +296,10 @@ mod tests {
 
     fn quad(material: u32, [a, b, c, d]: [[f32; 3]; 4]) -> Vec<Triangle> {
         let [a, b, c, d] = [a, b, c, d].map(Vec3::from);
-        vec![Triangle { vertices: [a, b, c], material }, Triangle { vertices: [a, c, d], material }]
+        vec![
+            Triangle { vertices: [a, b, c], material, file_vertices: [0, 1, 2] },
+            Triangle { vertices: [a, c, d], material, file_vertices: [0, 2, 3] },
+        ]
     }
 
     /// The surfaces of `quads`, one each.

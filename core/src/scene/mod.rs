@@ -124,6 +124,11 @@ pub struct Triangle {
     pub vertices: [Vec3; 3],
     /// Index into [`Scene::materials`].
     pub material: u32,
+    /// Which of the model file's vertices each corner is, numbered across
+    /// the file: faces of one solid share them, where two solids that
+    /// merely touch have points that are equal but not the same vertex
+    /// (the sun pass finds closed shells by them).
+    pub file_vertices: [u32; 3],
 }
 
 impl Triangle {

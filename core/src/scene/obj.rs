@@ -200,8 +200,11 @@ pub fn triangles(
     // would weigh on every ray and pass for nothing.
     let mut seen: std::collections::HashSet<([[u32; 3]; 3], u32)> = std::collections::HashSet::new();
     let mut duplicated = 0usize;
+    // tobj numbers each mesh's vertices from 0: numbered on across meshes.
+    let mut first_vertex = 0u32;
     for model_mesh in &model.meshes {
         let mesh = &model_mesh.mesh;
+        let file_vertex = |i: u32| first_vertex + i;
         let position = |i: u32| {
             let i = i as usize * 3;
             frame.point(DVec3::new(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2]))
@@ -215,12 +218,14 @@ pub fn triangles(
         };
         let mut start = 0;
         for arity in arities {
-            let face: Vec<Vec3> = mesh.indices[start..start + arity as usize].iter().map(|&i| position(i)).collect();
+            let indices = &mesh.indices[start..start + arity as usize];
+            let face: Vec<Vec3> = indices.iter().map(|&i| position(i)).collect();
             start += arity as usize;
             let pieces = polygon::triangulate(&face);
             degenerate += usize::from(pieces.is_empty());
             for [a, b, c] in pieces {
-                let triangle = Triangle { vertices: [face[a], face[b], face[c]], material };
+                let file_vertices = [a, b, c].map(|k| file_vertex(indices[k]));
+                let triangle = Triangle { vertices: [face[a], face[b], face[c]], material, file_vertices };
                 let mut corners = triangle.vertices.map(|v| v.to_array().map(f32::to_bits));
                 corners.sort_unstable();
                 if is_degenerate(&triangle) {
@@ -232,6 +237,7 @@ pub fn triangles(
                 }
             }
         }
+        first_vertex += (mesh.positions.len() / 3) as u32;
     }
     if duplicated > 0 {
         warnings.push(SceneWarning {

@@ -512,7 +512,10 @@ mod tests {
     fn quad(w: f32, h: f32) -> Vec<Triangle> {
         // A w × h wall in the xz plane, facing -y (south).
         let (a, b, c, d) = (Vec3::ZERO, Vec3::new(w, 0.0, 0.0), Vec3::new(w, 0.0, h), Vec3::new(0.0, 0.0, h));
-        vec![Triangle { vertices: [a, b, c], material: 0 }, Triangle { vertices: [a, c, d], material: 0 }]
+        vec![
+            Triangle { vertices: [a, b, c], material: 0, file_vertices: [0, 1, 2] },
+            Triangle { vertices: [a, c, d], material: 0, file_vertices: [0, 2, 3] },
+        ]
     }
 
     fn surface_of(triangles: &[Triangle]) -> Surface {

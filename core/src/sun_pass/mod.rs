@@ -221,13 +221,13 @@ impl SunPassSurfaces {
     /// 100,000 triangles, against milliseconds per sun move after it).
     pub fn new(scene: &Scene) -> Self {
         let lit = lit_vertices(scene);
-        let opaque = scene
+        let (opaque, vertices): (Vec<_>, Vec<_>) = scene
             .triangles
             .iter()
             .filter(|t| matches!(scene.materials[t.material as usize].kind, MaterialKind::Diffuse { .. }))
-            .map(|t| t.vertices)
-            .collect();
-        Self { runs: LitRuns::new(&lit), lit, opaque: Casters::new(opaque) }
+            .map(|t| (t.vertices, t.file_vertices))
+            .unzip();
+        Self { runs: LitRuns::new(&lit), lit, opaque: Casters::of_model(opaque, &vertices) }
     }
 
     /// How many lit triangles there are (9 floats per vertex).
