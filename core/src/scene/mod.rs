@@ -125,9 +125,10 @@ pub struct Triangle {
     /// Index into [`Scene::materials`].
     pub material: u32,
     /// Which of the model file's vertices each corner is, numbered across
-    /// the file: faces of one solid share them, where two solids that
-    /// merely touch have points that are equal but not the same vertex
-    /// (the sun pass finds closed shells by them).
+    /// the file (an OBJ vertex with its texture and normal, per group and
+    /// material): faces of one solid written with shared vertices share
+    /// them, where two solids that merely touch have points that are equal
+    /// but not the same vertex (the sun pass finds closed shells by them).
     pub file_vertices: [u32; 3],
 }
 

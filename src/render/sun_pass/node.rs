@@ -51,6 +51,8 @@ pub(super) fn sun_pass(
     // records them (the render bench's `HELIODON_BENCH_GPU_TIMES`).
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
+    // A span's name, made only where spans are recorded.
+    let name = |make: &dyn Fn() -> String| if diagnostics.is_some() { make() } else { String::new() };
     let lit_vertices = (frame.surfaces.lit.len() / 9) as u32;
     let mut light_index = 0;
     for (pass_index, direction) in frame.passes.iter().enumerate() {
@@ -69,7 +71,7 @@ pub(super) fn sun_pass(
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        let pass_span = diagnostics.pass_span(&mut pass, format!("heliodon_sun_pass {pass_index}"));
+        let pass_span = diagnostics.pass_span(&mut pass, name(&|| format!("heliodon_sun_pass {pass_index}")));
         if let Some(viewport) = camera.viewport.as_ref() {
             let (position, size) = (viewport.physical_position.as_vec2(), viewport.physical_size.as_vec2());
             pass.set_viewport(position.x, position.y, size.x, size.y, viewport.depth.start, viewport.depth.end);
@@ -114,7 +116,7 @@ pub(super) fn sun_pass(
         draw_volumes!(count_volume, direction.opaque_sides.clone());
         span.end(&mut pass);
         for light in &direction.lights {
-            let span = diagnostics.time_span(&mut pass, format!("light {light_index}"));
+            let span = diagnostics.time_span(&mut pass, name(&|| format!("light {light_index}")));
             match &light.aperture {
                 Some(aperture) => {
                     draw_volumes!(toggle_volume, aperture.clone());
