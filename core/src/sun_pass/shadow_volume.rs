@@ -90,8 +90,8 @@ enum Meeting {
 struct Edges {
     /// What meets each edge (index 3t + k, from corner k to k + 1).
     meets: Vec<Meeting>,
-    /// The edges between each two corners.
-    groups: Vec<Vec<u32>>,
+    /// The edges of each place where three or more meet.
+    crowds: Vec<Vec<u32>>,
 }
 
 impl Edges {
@@ -113,8 +113,8 @@ impl Edges {
             by_corners.entry((p.min(q), p.max(q))).or_default().push(edge as u32);
         }
         let mut meets = vec![Meeting::Open; triangles * 3];
-        let groups: Vec<Vec<u32>> = by_corners.into_values().collect();
-        for edges in &groups {
+        let mut crowds = Vec::new();
+        for edges in by_corners.into_values() {
             match edges[..] {
                 [_] => {}
                 [first, second] => {
@@ -122,10 +122,13 @@ impl Edges {
                     meets[first as usize] = Meeting::Pair(second, same);
                     meets[second as usize] = Meeting::Pair(first, same);
                 }
-                _ => edges.iter().for_each(|&edge| meets[edge as usize] = Meeting::Crowd),
+                _ => {
+                    edges.iter().for_each(|&edge| meets[edge as usize] = Meeting::Crowd);
+                    crowds.push(edges);
+                }
             }
         }
-        Self { meets, groups }
+        Self { meets, crowds }
     }
 }
 
@@ -159,8 +162,7 @@ impl Casters {
     }
 
     fn with_shells(triangles: Vec<[Vec3; 3]>, edges: Edges, shell_winding: Vec<i8>) -> Self {
-        let crowds = edges.groups.into_iter().filter(|group| group.len() > 2).collect();
-        Self { triangles, meets: edges.meets, crowds, shell_winding }
+        Self { triangles, meets: edges.meets, crowds: edges.crowds, shell_winding }
     }
 
     /// The casters, as given.
