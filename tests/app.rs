@@ -662,6 +662,7 @@ fn the_day_series_of_a_sensor_follows_the_sun() {
         rays_per_patch: 32,
         rays_per_sensor: 256,
         sky_rays_per_sensor: 256,
+        window_rays_per_sensor: 128,
         sun_samples_per_patch: 4,
         area_sensor_sun_grid: 4,
         ..Default::default()

@@ -97,6 +97,7 @@ fn quick() -> heliodon::light::LightSettings {
         rays_per_patch: 16,
         rays_per_sensor: 64,
         sky_rays_per_sensor: 64,
+        window_rays_per_sensor: 32,
         sun_samples_per_patch: 64,
         ..Default::default()
     }
@@ -109,10 +110,13 @@ fn quick() -> heliodon::light::LightSettings {
 fn a_straight_lobe_passes_the_sun_as_an_opening_does() {
     use std::sync::Arc;
     let catalog = all_panels();
-    // Direct sun and direct sky at each floor sensor.
+    // Direct sun and direct sky at each floor sensor, the sky by the same
+    // hemisphere rays through the opening and the panel (an opening is no
+    // window that rays could be aimed at).
+    let settings = heliodon::light::LightSettings { window_rays_per_sensor: 0, ..quick() };
     let direct = |path: PathBuf| -> Vec<(f64, f64)> {
         let scene = Arc::new(load_scene(&path, &catalog).unwrap().scene);
-        let model = heliodon::light::LightModel::precompute(scene.clone(), quick()).unwrap();
+        let model = heliodon::light::LightModel::precompute(scene.clone(), settings).unwrap();
         let lighting = model.solve(&winter_noon(&scene), None);
         lighting.sensors.iter().map(|s| (s.direct_sun, s.direct_sky)).collect()
     };

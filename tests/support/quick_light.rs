@@ -9,6 +9,7 @@ pub fn quick_light() -> LightSettings {
         rays_per_patch: 64,
         rays_per_sensor: 512,
         sky_rays_per_sensor: 512,
+        window_rays_per_sensor: 256,
         sun_samples_per_patch: 4,
         area_sensor_sun_grid: 4,
         ..Default::default()

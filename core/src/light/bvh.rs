@@ -103,6 +103,7 @@ mod tests {
                 [Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0)],
                 [Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, 1.0, 0.0)],
             ],
+            clusters: Vec::new(),
         };
         let tracer = Tracer::new(&mesh);
         for origin in [DVec3::new(0.0, 0.0, 0.5), DVec3::new(0.3, -0.2, 0.5)] {

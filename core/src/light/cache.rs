@@ -113,10 +113,16 @@ pub fn key(scene: &Scene, settings: &LightSettings) -> u64 {
     for surface in &scene.surfaces {
         hash.u64(u64::from(surface.material));
     }
+    // The sides left dark inside solids (which shells close depends on the
+    // file's vertices as well as on the points).
+    for (side, _) in super::solids::dark_sides(scene).iter().enumerate().filter(|(_, dark)| **dark) {
+        hash.u64(side as u64);
+    }
     hash.u64(settings.rays_per_patch as u64)
         .u64(settings.window_rays_per_patch as u64)
         .u64(settings.rays_per_sensor as u64)
         .u64(settings.sky_rays_per_sensor as u64)
+        .u64(settings.window_rays_per_sensor as u64)
         .u64(settings.sun_samples_per_patch as u64)
         .u64(settings.area_sensor_sun_grid as u64)
         .u64(u64::from(settings.sky_subdivision))

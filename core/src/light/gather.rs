@@ -107,6 +107,19 @@ struct Aim {
     near: bool,
 }
 
+/// What a receiver aims rays at, and how many.
+#[derive(Clone, Copy)]
+struct Aiming<'a> {
+    /// The receiver's normal.
+    normal: DVec3,
+    aimed: &'a [Aim],
+    targets: &'a [WindowTarget],
+    /// Rays aimed.
+    rays: usize,
+    /// Hemisphere rays the receiver's coefficients are counted in.
+    hemisphere: usize,
+}
+
 /// How far in front of a patch side (m) a vertex of a window must lie for
 /// the side to aim at it: a wall around its own window sees none of it.
 const WINDOW_IN_FRONT: f64 = 1e-4;
@@ -235,14 +248,15 @@ impl LightModel {
             }
         };
         let targets = model.window_targets();
+        let dark = super::solids::dark_sides(&model.scene);
         model.side_gathers = par_map(model.settings.threads, patches.len() * 2, |side| {
-            let gather = model.gather_patch_side(side, &targets);
+            let gather = if dark[side] { Gather::default() } else { model.gather_patch_side(side, &targets) };
             tick();
             gather
         });
         let sensors = model.scene.sensors.clone();
         model.sensors = par_map(model.settings.threads, sensors.len(), |i| {
-            let geometry = model.sensor_geometry(i, &sensors[i]);
+            let geometry = model.sensor_geometry(i, &sensors[i], &targets);
             tick();
             geometry
         });
@@ -340,7 +354,8 @@ impl LightModel {
         let patch = &self.scene.patches.patches[patch_index];
         let normal = patch.normal.as_dvec3() * if side % 2 == 1 { -1.0 } else { 1.0 };
         let triangles = self.patch_triangles(patch_index);
-        let aimed = self.windows_to_aim_at(patch, normal, targets);
+        let reach = f64::from(patch.area).sqrt() * std::f64::consts::SQRT_2;
+        let aimed = self.windows_to_aim_at(patch.centroid.as_dvec3(), reach, normal, self.settings.window_rays_per_patch, targets);
         let aimed_window = |w: u32| aimed.iter().any(|a| targets[a.target].window == w);
         let mut rng = Rng::new(1, side as u64);
         let hemisphere = self.settings.rays_per_patch;
@@ -352,12 +367,23 @@ impl LightModel {
             let point = sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET;
             self.follow(point, dir, 1.0, 0, Way::START, &not_aimed, &mut coefficients, &mut hits);
         }
-        let rays = self.settings.window_rays_per_patch;
+        let aiming = Aiming { normal, aimed: &aimed, targets, rays: self.settings.window_rays_per_patch, hemisphere };
+        self.aim_at_windows(&aiming, &mut rng, |rng| sample_area(&triangles, rng) + normal * SURFACE_OFFSET, &mut coefficients);
+        Gather::from_raw(coefficients, &hits, hemisphere)
+    }
+
+    /// Traces `aiming.rays` rays aimed at its windows from points `point`
+    /// draws, adding the sky straight through each window to
+    /// `coefficients`: stratified over the windows by their odds, and
+    /// within a near window by the rest of the stratum; each ray weighted
+    /// by cos·Ω/(π P) for the solid angle Ω its direction was drawn from
+    /// and the odds P of its window, in units of the receiver's
+    /// `aiming.hemisphere` hemisphere rays.
+    fn aim_at_windows(&self, aiming: &Aiming, rng: &mut Rng, mut point: impl FnMut(&mut Rng) -> DVec3, coefficients: &mut Vec<(u32, f64)>) {
+        let Aiming { normal, aimed, targets, rays, hemisphere } = *aiming;
         let odds_total: f64 = aimed.iter().map(|a| a.odds).sum();
         let mut ignored = Vec::new();
         for j in (0..rays).filter(|_| !aimed.is_empty()) {
-            // Stratified over the windows by their odds, and within a near
-            // window by the rest of the stratum.
             let mut pick = (j as f64 + rng.next_f64()) / rays as f64 * odds_total;
             let aim = aimed
                 .iter()
@@ -368,30 +394,28 @@ impl LightModel {
                 .unwrap_or(aimed.last().expect("aimed is not empty"));
             let within = ((pick + aim.odds) / aim.odds).clamp(0.0, 1.0);
             let target = &targets[aim.target];
-            let point = sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET;
-            let Some((dir, solid_angle)) = target.aim(point, aim.near, within, &mut rng) else { continue };
+            let point = point(rng);
+            let Some((dir, solid_angle)) = target.aim(point, aim.near, within, rng) else { continue };
             let cos_here = normal.dot(dir);
             if cos_here <= 0.0 {
                 continue;
             }
             let weight = cos_here * solid_angle / (std::f64::consts::PI * aim.odds / odds_total) * hemisphere as f64 / rays as f64;
             let straight_through = |way: Way| !way.reflected && way.window == Some(target.window);
-            self.follow(point, dir, weight, 0, Way::START, &straight_through, &mut coefficients, &mut ignored);
+            self.follow(point, dir, weight, 0, Way::START, &straight_through, coefficients, &mut ignored);
             ignored.clear();
         }
-        Gather::from_raw(coefficients, &hits, hemisphere)
     }
 
-    /// The windows a patch side sees, with the odds of aiming a ray at
-    /// each: seen from afar by their solid angle from the patch's centre,
-    /// near ones by the solid angle of their triangles, times the cosine
-    /// there (at least 0.1: the odds only spread the rays, and a window
-    /// seen at a grazing angle must keep some).
-    fn windows_to_aim_at(&self, patch: &crate::scene::Patch, normal: DVec3, targets: &[WindowTarget]) -> Vec<Aim> {
-        let centre = patch.centroid.as_dvec3();
-        let reach = f64::from(patch.area).sqrt() * std::f64::consts::SQRT_2;
+    /// The windows a receiver (a patch side, a sensor) at `centre`, `reach`
+    /// across, facing `normal`, sees, with the odds of aiming a ray at
+    /// each: seen from afar by their solid angle from the centre, near
+    /// ones by the solid angle of their triangles, times the cosine there
+    /// (at least 0.1: the odds only spread the rays, and a window seen at a
+    /// grazing angle must keep some). None where no `rays` are aimed.
+    fn windows_to_aim_at(&self, centre: DVec3, reach: f64, normal: DVec3, rays: usize, targets: &[WindowTarget]) -> Vec<Aim> {
         let mut aimed = Vec::new();
-        if self.settings.window_rays_per_patch == 0 {
+        if rays == 0 {
             return aimed;
         }
         for (k, target) in targets.iter().enumerate() {
@@ -451,22 +475,30 @@ impl LightModel {
         with_cumulative_areas(self.scene.patches.triangles[range.start as usize..range.end as usize].iter().copied())
     }
 
-    /// A sensor's gather, its sun points and where its rays land.
-    fn sensor_geometry(&self, index: usize, sensor: &Sensor) -> SensorGeometry {
+    /// A sensor's gather, its sun points and where its rays land. As a
+    /// patch side's, the sky through the windows it sees comes from rays
+    /// aimed at them ([`LightSettings::window_rays_per_sensor`]), the rest
+    /// from its hemisphere rays.
+    fn sensor_geometry(&self, index: usize, sensor: &Sensor, targets: &[WindowTarget]) -> SensorGeometry {
         let normal = sensor.normal.as_dvec3();
         let points = place_sensor(&self.tracer, sensor, 4);
         let sun_points = match sensor.size {
             Some(_) => place_sensor(&self.tracer, sensor, self.settings.area_sensor_sun_grid),
             None => points.clone(),
         };
+        let centre = points.iter().sum::<DVec3>() / points.len() as f64;
+        let reach = f64::from(sensor.size.unwrap_or(0.0)) * std::f64::consts::SQRT_2;
+        let aimed = self.windows_to_aim_at(centre, reach, normal, self.settings.window_rays_per_sensor, targets);
+        let aimed_window = |w: u32| aimed.iter().any(|a| targets[a.target].window == w);
+        let not_aimed = |way: Way| way.reflected || !way.window.is_some_and(aimed_window);
         let mut rng = Rng::new(2, index as u64);
         let per_point = self.settings.rays_per_sensor.div_ceil(points.len());
         let more_per_point = self.settings.sky_rays_per_sensor.saturating_sub(self.settings.rays_per_sensor).div_ceil(points.len());
         let (mut coefficients, mut hits) = (Vec::new(), Vec::new());
-        let mut trace = |count: usize, coefficients: &mut Vec<(u32, f64)>, hits: &mut Vec<SideHit>| {
+        let trace = |count: usize, coefficients: &mut Vec<(u32, f64)>, hits: &mut Vec<SideHit>, rng: &mut Rng| {
             for &point in &points {
-                for dir in cosine_directions(normal, count, &mut rng) {
-                    self.follow(point, dir, 1.0, 0, Way::START, &|_| true, coefficients, hits);
+                for dir in cosine_directions(normal, count, rng) {
+                    self.follow(point, dir, 1.0, 0, Way::START, &not_aimed, coefficients, hits);
                 }
             }
             count * points.len()
@@ -477,11 +509,22 @@ impl LightModel {
         // of whose rays (those aimed at the windows it faces included) saw
         // the sky is dark to the sun (as `openings` has it), and the landings
         // are most of a sensor's memory (none in a windowless room).
-        let bounce_rays = trace(per_point, &mut coefficients, &mut hits);
+        let bounce_rays = trace(per_point, &mut coefficients, &mut hits, &mut rng);
         let bounce =
             hits.iter().filter(|h| self.may_be_sunlit(h.side)).map(|h| (h.side, (h.weight / bounce_rays as f64) as f32, h.point)).collect();
         let landings = Landings::new(bounce, &self.patch_boxes);
-        let rays = bounce_rays + trace(more_per_point, &mut coefficients, &mut hits);
+        let rays = bounce_rays + trace(more_per_point, &mut coefficients, &mut hits, &mut rng);
+        let aiming = Aiming { normal, aimed: &aimed, targets, rays: self.settings.window_rays_per_sensor, hemisphere: rays };
+        let mut next = 0;
+        self.aim_at_windows(
+            &aiming,
+            &mut rng,
+            |_| {
+                next += 1;
+                points[(next - 1) % points.len()]
+            },
+            &mut coefficients,
+        );
         SensorGeometry::new(Gather::from_raw(coefficients, &hits, rays), sun_points, normal, landings)
     }
 }

@@ -42,6 +42,7 @@ mod openings;
 pub mod panels;
 mod sampling;
 pub mod settings;
+mod solids;
 pub mod solver;
 pub mod sun;
 mod totals;
@@ -118,7 +119,8 @@ pub struct LightModel {
     openings: openings::Openings,
     /// Per patch, the box its sensors' landings are stored in.
     patch_boxes: Vec<landings::PatchBox>,
-    /// Per patch side (2 per patch; empty for glass and the outer side of panels).
+    /// Per patch side (2 per patch; empty for glass, the outer side of
+    /// panels and sides inside solids, `solids`).
     side_gathers: Vec<Gather>,
     sensors: Vec<SensorGeometry>,
 }

@@ -86,10 +86,7 @@ pub fn sample_area(triangles: &[([DVec3; 3], f64)], rng: &mut Rng) -> DVec3 {
 /// The solid angle (sr) triangle `t` fills seen from `eye` (Van Oosterom
 /// and Strackee 1983), whichever side it is seen from.
 pub fn solid_angle(eye: DVec3, t: &[DVec3; 3]) -> f64 {
-    let [a, b, c] = t.map(|v| (v - eye).normalize_or_zero());
-    let det = a.dot(b.cross(c)).abs();
-    let denominator = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
-    2.0 * det.atan2(denominator)
+    crate::scene::shells::signed_solid_angle(eye, t).abs()
 }
 
 /// A direction from `eye` toward triangle `t`, uniformly distributed over

@@ -21,6 +21,7 @@ pub mod save;
 pub(crate) use patches::clip as clip_convex;
 mod sensors;
 mod shades;
+pub(crate) mod shells;
 mod surfaces;
 
 use std::future::Future;

@@ -62,6 +62,9 @@ pub struct PatchMesh {
     /// Render triangles in the canonical frame, ordered by patch, with the
     /// winding of the model triangle they came from.
     pub triangles: Vec<[Vec3; 3]>,
+    /// Per cluster of clutter, its patch and the surfaces it holds (the
+    /// first lists the patch; every other patch is its surface's part).
+    pub clusters: Vec<(u32, Vec<u32>)>,
 }
 
 impl PatchMesh {
@@ -81,6 +84,7 @@ impl PatchMesh {
             }
         }
         let first = &surfaces[cluster[0] as usize];
+        self.clusters.push((self.patches.len() as u32, cluster.to_vec()));
         self.patches.push(Patch {
             surface: cluster[0],
             material: first.material,
@@ -89,6 +93,14 @@ impl PatchMesh {
             centroid: moment / area.max(f32::MIN_POSITIVE),
             triangles: start..self.triangles.len() as u32,
         });
+    }
+
+    /// The surfaces whose triangles patch `patch` holds.
+    pub fn surfaces_of(&self, patch: u32) -> &[u32] {
+        match self.clusters.binary_search_by_key(&patch, |c| c.0) {
+            Ok(k) => &self.clusters[k].1,
+            Err(_) => std::slice::from_ref(&self.patches[patch as usize].surface),
+        }
     }
 
     /// The patch each render triangle belongs to.

@@ -26,7 +26,8 @@
 use std::ops::Range;
 
 use glam::{Vec3, Vec4};
-use rustc_hash::FxHashMap;
+
+use crate::scene::shells::{Edges, Meeting, closed_shells, model_shells};
 
 /// Triangles whose normal is this close to perpendicular to the light cast
 /// no volume (their shadow has no area).
@@ -75,69 +76,12 @@ pub struct Casters {
     shell_winding: Vec<i8>,
 }
 
-/// What else meets a caster's edge.
-#[derive(Debug, Clone, Copy)]
-enum Meeting {
-    Open,
-    /// One other edge between the same two points, and whether it runs the same way.
-    Pair(u32, bool),
-    /// Several: one of [`Casters::crowds`].
-    Crowd,
-}
-
-/// The edges of a set of triangles grouped by the two corners they join,
-/// corners being the same where `corner` says so.
-struct Edges {
-    /// What meets each edge (index 3t + k, from corner k to k + 1).
-    meets: Vec<Meeting>,
-    /// The edges of each place where three or more meet.
-    crowds: Vec<Vec<u32>>,
-}
-
-impl Edges {
-    /// Edges between points that are equal to the bit.
-    fn by_points(triangles: &[[Vec3; 3]]) -> Self {
-        Self::between(triangles.len(), |corner| triangles[corner / 3][corner % 3].to_array().map(f32::to_bits))
-    }
-
-    /// `corner(3t + k)` is corner k of triangle t, as something equal where
-    /// the corners are one (hashed with Fx, not SipHash: the keys are the
-    /// model's own points or vertex numbers).
-    fn between<K: Copy + Ord + std::hash::Hash>(triangles: usize, corner: impl Fn(usize) -> K) -> Self {
-        let mut by_corners: FxHashMap<(K, K), Vec<u32>> = FxHashMap::default();
-        by_corners.reserve(triangles * 2);
-        let mut forward = Vec::with_capacity(triangles * 3);
-        for edge in 0..triangles * 3 {
-            let (p, q) = (corner(edge), corner(edge - edge % 3 + (edge + 1) % 3));
-            forward.push(p < q);
-            by_corners.entry((p.min(q), p.max(q))).or_default().push(edge as u32);
-        }
-        let mut meets = vec![Meeting::Open; triangles * 3];
-        let mut crowds = Vec::new();
-        for edges in by_corners.into_values() {
-            match edges[..] {
-                [_] => {}
-                [first, second] => {
-                    let same = forward[first as usize] == forward[second as usize];
-                    meets[first as usize] = Meeting::Pair(second, same);
-                    meets[second as usize] = Meeting::Pair(first, same);
-                }
-                _ => {
-                    edges.iter().for_each(|&edge| meets[edge as usize] = Meeting::Crowd);
-                    crowds.push(edges);
-                }
-            }
-        }
-        Self { meets, crowds }
-    }
-}
-
 impl Casters {
     /// `triangles` with their shared edges found (points that are equal
     /// to the bit meet), closed shells too.
     pub fn new(triangles: Vec<[Vec3; 3]>) -> Self {
         let edges = Edges::by_points(&triangles);
-        let shell_winding = closed_shells(&triangles, &edges);
+        let shell_winding = closed_shells(&triangles, &edges).winding;
         Self::with_shells(triangles, edges, shell_winding)
     }
 
@@ -145,19 +89,10 @@ impl Casters {
     /// (`vertices[t][k]`, equal numbers for one vertex): shells are found
     /// by those too, so a solid that touches another along an edge (a wall
     /// standing on a slab's edge: four faces meet there) is still a shell;
-    /// sides still cancel wherever points are equal.
-    ///
-    /// Where points close a shell (a file of faces that share no vertices)
-    /// that shell is kept; else the vertices' shells, which lie within one
-    /// set of casters joined by points, never across two: each shell found
-    /// one way or the other is whole.
+    /// sides still cancel wherever points are equal ([`model_shells`]).
     pub fn of_model(triangles: Vec<[Vec3; 3]>, vertices: &[[u32; 3]]) -> Self {
-        debug_assert_eq!(triangles.len(), vertices.len());
         let edges = Edges::by_points(&triangles);
-        let by_points = closed_shells(&triangles, &edges);
-        let by_vertices = closed_shells(&triangles, &Edges::between(triangles.len(), |corner| vertices[corner / 3][corner % 3]));
-        let shell_winding =
-            by_points.iter().zip(by_vertices).map(|(&points, vertices)| if points != 0 { points } else { vertices }).collect();
+        let shell_winding = model_shells(&triangles, &edges, vertices).winding;
         Self::with_shells(triangles, edges, shell_winding)
     }
 
@@ -255,64 +190,6 @@ impl Casters {
         }
         (start..caps_end, caps_end..out.len() as u32)
     }
-}
-
-/// [`Casters::shell_winding`]: the closed shells among `triangles`, whose
-/// edges are [`Edges`]: sets of casters joined edge to edge, each edge met
-/// by exactly one other (no open edge, no place where three or more faces
-/// meet), their windings made to agree across each edge and then turned
-/// outward (the solid they bound has a positive volume). Turned outward,
-/// the faces toward the light shade the shell's inside too: a point within
-/// the solid, or within a closed room modelled as one, sees the light
-/// through one of them.
-fn closed_shells(triangles: &[[Vec3; 3]], edges: &Edges) -> Vec<i8> {
-    let n = triangles.len();
-    // Windings as made to agree (0: not reached yet), and the shells'.
-    let mut winding = vec![0i8; n];
-    let mut shells = vec![0i8; n];
-    let mut stack = Vec::new();
-    let mut shell = Vec::new();
-    for seed in 0..n {
-        if winding[seed] != 0 {
-            continue;
-        }
-        // The set joined to `seed` edge to edge, windings made to agree.
-        winding[seed] = 1;
-        stack.push(seed);
-        shell.clear();
-        let mut closed = true;
-        while let Some(t) = stack.pop() {
-            shell.push(t);
-            for edge in 3 * t..3 * t + 3 {
-                let Meeting::Pair(other, same) = edges.meets[edge] else {
-                    closed = false;
-                    continue;
-                };
-                let (other, agreeing) = (other as usize / 3, if same { -winding[t] } else { winding[t] });
-                if winding[other] == 0 {
-                    winding[other] = agreeing;
-                    stack.push(other);
-                } else if winding[other] != agreeing {
-                    closed = false; // a one-sided surface (a twisted band)
-                }
-            }
-        }
-        // Six times the signed volume, about a corner of the shell (f64: a
-        // thin slab far from the origin is still told apart).
-        let origin = triangles[seed][0].as_dvec3();
-        let volume: f64 = shell
-            .iter()
-            .map(|&t| {
-                let [a, b, c] = triangles[t].map(|v| v.as_dvec3() - origin);
-                f64::from(winding[t]) * a.dot(b.cross(c))
-            })
-            .sum();
-        if closed {
-            let outward = if volume < 0.0 { -1 } else { 1 };
-            shell.iter().for_each(|&t| shells[t] = winding[t] * outward);
-        }
-    }
-    shells
 }
 
 #[cfg(test)]

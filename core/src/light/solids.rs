@@ -1,0 +1,243 @@
+//! The insides of solids. A patch side that looks into a closed opaque
+//! shell (the inner side of a wall's or a slab's face: half the patch
+//! sides of a model built of solids, as a converted IFC model is) sees no
+//! daylight: every path from the sky to it crosses the shell. Its gather
+//! would trace rays that find only other such sides, and its form factors
+//! would be half the cache; it is left dark and untraced instead.
+//!
+//! A shell that holds a window (a pane inside a wall with no opening cut
+//! for it, a window pasted onto a closed room's wall) is left to the ray
+//! tracer: whether light passes there depends on which face a ray meets
+//! first, and that is not this module's to decide.
+
+use glam::DVec3;
+
+use super::gather::side_of;
+use crate::scene::shells::{Edges, Shells, model_shells, winding_number};
+use crate::scene::{MaterialKind, Scene};
+
+/// How far (m) from a window's face its inside is probed.
+const WINDOW_PROBE: f64 = 1e-3;
+
+/// Per patch side ([`side_of`]): whether it looks into a closed shell of
+/// opaque surfaces that holds no window, so no daylight reaches it. The
+/// surfaces' materials are the scene's as they are now (a material made
+/// glass at run time opens its shells).
+pub(super) fn dark_sides(scene: &Scene) -> Vec<bool> {
+    let opaque = |material: u32| matches!(scene.materials[material as usize].kind, MaterialKind::Diffuse { .. });
+    // The opaque surfaces' triangles, and where each surface's start.
+    let mut triangles = Vec::new();
+    let mut vertices = Vec::new();
+    let mut first = vec![u32::MAX; scene.surfaces.len()];
+    for (k, surface) in scene.surfaces.iter().enumerate().filter(|(_, s)| opaque(s.material)) {
+        first[k] = triangles.len() as u32;
+        for triangle in &scene.triangles[surface.triangles.start as usize..surface.triangles.end as usize] {
+            triangles.push(triangle.vertices);
+            vertices.push(triangle.file_vertices);
+        }
+    }
+    let mut shells = model_shells(&triangles, &Edges::by_points(&triangles), &vertices);
+    open_shells_holding_windows(scene, &triangles, &mut shells, |material| !opaque(material));
+    // Per surface: +1 where its shells' outside is the way its normal
+    // points, −1 the other way, 0 where it is not wholly a shell's face.
+    let outward: Vec<i8> = scene
+        .surfaces
+        .iter()
+        .enumerate()
+        .map(|(k, surface)| {
+            if first[k] == u32::MAX {
+                return 0;
+            }
+            let mut common = None;
+            let own = first[k] as usize..first[k] as usize + surface.triangles.len();
+            for (&[a, b, c], &winding) in triangles[own.clone()].iter().zip(&shells.winding[own]) {
+                let way = (b - a).cross(c - a).dot(surface.normal);
+                let out = if way > 0.0 {
+                    winding
+                } else if way < 0.0 {
+                    -winding
+                } else {
+                    0
+                };
+                if out == 0 || common.is_some_and(|c| c != out) {
+                    return 0;
+                }
+                common = Some(out);
+            }
+            common.unwrap_or(0)
+        })
+        .collect();
+    let mesh = &scene.patches;
+    let mut dark = vec![false; mesh.patches.len() * 2];
+    for (p, patch) in mesh.patches.iter().enumerate() {
+        // A cluster's surfaces must agree, each as it faces the patch's normal.
+        let ways = mesh.surfaces_of(p as u32).iter().map(|&s| {
+            let facing = scene.surfaces[s as usize].normal.dot(patch.normal);
+            if facing > 0.0 {
+                outward[s as usize]
+            } else if facing < 0.0 {
+                -outward[s as usize]
+            } else {
+                0
+            }
+        });
+        let mut ways = ways.peekable();
+        let Some(&way) = ways.peek() else { continue };
+        if way != 0 && ways.all(|w| w == way) {
+            // Outside along the normal: the back side looks in.
+            dark[side_of(p as u32, way > 0) as usize] = true;
+        }
+    }
+    dark
+}
+
+/// Takes out of `shells` every shell that has a window (a surface whose
+/// material `passes_light`) inside it or on its faces: a point just off
+/// either face of a window triangle lies within the solid.
+fn open_shells_holding_windows(scene: &Scene, triangles: &[[glam::Vec3; 3]], shells: &mut Shells, passes_light: impl Fn(u32) -> bool) {
+    // Each shell's triangles and box.
+    let mut members: std::collections::BTreeMap<u32, (Vec<usize>, DVec3, DVec3)> = std::collections::BTreeMap::new();
+    for (t, &shell) in shells.shell.iter().enumerate().filter(|(t, _)| shells.winding[*t] != 0) {
+        let entry = members.entry(shell).or_insert((Vec::new(), DVec3::INFINITY, DVec3::NEG_INFINITY));
+        entry.0.push(t);
+        for v in triangles[t] {
+            entry.1 = entry.1.min(v.as_dvec3());
+            entry.2 = entry.2.max(v.as_dvec3());
+        }
+    }
+    let probes: Vec<DVec3> = scene
+        .surfaces
+        .iter()
+        .filter(|s| passes_light(s.material))
+        .flat_map(|s| &scene.triangles[s.triangles.start as usize..s.triangles.end as usize])
+        .flat_map(|t| {
+            let centre = t.centroid().as_dvec3();
+            let normal = t.normal().as_dvec3() * WINDOW_PROBE;
+            [centre + normal, centre - normal]
+        })
+        .collect();
+    for (faces, lo, hi) in members.values() {
+        let holds_window = probes.iter().filter(|p| p.cmpge(*lo).all() && p.cmple(*hi).all()).any(|&p| {
+            let outward = faces.iter().map(|&t| {
+                let [a, b, c] = triangles[t].map(|v| v.as_dvec3());
+                if shells.winding[t] > 0 { [a, b, c] } else { [a, c, b] }
+            });
+            winding_number(p, outward).abs() > 0.5
+        });
+        if holds_window {
+            faces.iter().for_each(|&t| shells.winding[t] = 0);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::fmt::Write as _;
+    use std::path::Path;
+
+    use super::*;
+    use crate::panel::PanelCatalog;
+    use crate::scene::load_scene;
+
+    /// The faces of a union of grid cells, each wound outward (or inward,
+    /// `inward`), as OBJ quads of material `material`: cells `filled(i, j,
+    /// k)` of the grid with lines `xs`, `ys`, `zs`. Faces between two filled
+    /// cells are left out, so the surface is closed and every edge meets
+    /// exactly one other (no two cells meet along an edge alone here).
+    fn cells_obj(obj: &mut String, material: &str, [xs, ys, zs]: [&[f64]; 3], filled: impl Fn([usize; 3]) -> bool, inward: bool) {
+        let n = [xs.len() - 1, ys.len() - 1, zs.len() - 1];
+        let lines = [xs, ys, zs];
+        let is_filled = |c: [i64; 3]| (0..3).all(|a| c[a] >= 0 && (c[a] as usize) < n[a]) && filled(c.map(|v| v as usize));
+        let _ = writeln!(obj, "usemtl {material}");
+        for i in 0..n[0] {
+            for j in 0..n[1] {
+                for k in 0..n[2] {
+                    let cell = [i, j, k];
+                    if !filled(cell) {
+                        continue;
+                    }
+                    for axis in 0..3 {
+                        for step in [-1i64, 1] {
+                            let mut next = cell.map(|v| v as i64);
+                            next[axis] += step;
+                            if is_filled(next) {
+                                continue;
+                            }
+                            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                            let at = |du: usize, dv: usize| {
+                                let mut p = [0.0; 3];
+                                p[axis] = lines[axis][cell[axis] + usize::from(step > 0)];
+                                p[u] = lines[u][cell[u] + du];
+                                p[v] = lines[v][cell[v] + dv];
+                                p
+                            };
+                            // (u, v) counter-clockwise faces +axis.
+                            let mut quad = [at(0, 0), at(1, 0), at(1, 1), at(0, 1)];
+                            if (step < 0) != inward {
+                                quad.reverse();
+                            }
+                            for p in quad {
+                                let _ = writeln!(obj, "v {} {} {}", p[0], p[1], p[2]);
+                            }
+                            let _ = writeln!(obj, "f -4 -3 -2 -1");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    fn scene_of(dir: &Path, obj: &str) -> Scene {
+        std::fs::create_dir_all(dir).unwrap();
+        std::fs::write(dir.join("m.obj"), format!("mtllib m.mtl\n{obj}")).unwrap();
+        std::fs::write(dir.join("m.mtl"), "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.8\n").unwrap();
+        std::fs::write(dir.join("scene.toml"), "[site]\nlatitude = 45.0\nlongitude = 0.0\ntimezone = 0.0\n[model]\nobj = \"m.obj\"\n")
+            .unwrap();
+        load_scene(&dir.join("scene.toml"), &PanelCatalog::new()).unwrap().scene
+    }
+
+    /// Per patch of material `name`: (front dark, back dark).
+    fn dark_of(scene: &Scene, name: &str) -> Vec<(bool, bool)> {
+        let material = scene.materials.iter().position(|m| m.name == name).unwrap() as u32;
+        let dark = dark_sides(scene);
+        (0..scene.patches.patches.len() as u32)
+            .filter(|&p| scene.patches.patches[p as usize].material == material)
+            .map(|p| (dark[side_of(p, false) as usize], dark[side_of(p, true) as usize]))
+            .collect()
+    }
+
+    /// A wall 4 × 0.3 × 3 m with an opening for its window, glazed in the
+    /// middle of its depth: the inside of the wall is dark, its outside
+    /// faces and the pane are not. The same wall without the opening, the
+    /// pane inside it, is left to the ray tracer; so is a closed room
+    /// (modelled from within) with a pane on a wall, and a closed room
+    /// without one is dark inside.
+    #[test]
+    fn the_inside_of_a_solid_without_windows_is_dark() {
+        let dir = std::env::temp_dir().join(format!("heliodon-solids-{}", std::process::id()));
+        let grid: [&[f64]; 3] = [&[0.0, 1.0, 3.0, 4.0], &[0.0, 0.3], &[0.0, 0.9, 2.3, 3.0]];
+        let pane = "usemtl glass\nv 1 0.15 0.9\nv 3 0.15 0.9\nv 3 0.15 2.3\nv 1 0.15 2.3\nf -4 -3 -2 -1\n";
+        let mut obj = String::new();
+        cells_obj(&mut obj, "wall", grid, |c| c != [1, 0, 1], false);
+        let scene = scene_of(&dir.join("opening"), &(obj + pane));
+        let wall = dark_of(&scene, "wall");
+        assert!(wall.len() > 8 && wall.iter().all(|&d| d == (false, true)), "{wall:?}");
+        assert!(dark_of(&scene, "glass").iter().all(|&d| d == (false, false)));
+
+        let mut obj = String::new();
+        cells_obj(&mut obj, "wall", grid, |_| true, false);
+        let scene = scene_of(&dir.join("no-opening"), &(obj + pane));
+        assert!(dark_of(&scene, "wall").iter().all(|&d| d == (false, false)));
+
+        let room: [&[f64]; 3] = [&[0.0, 4.0], &[0.0, 5.0], &[0.0, 3.0]];
+        let mut obj = String::new();
+        cells_obj(&mut obj, "wall", room, |_| true, true);
+        let closed = scene_of(&dir.join("closed-room"), &obj);
+        let inside = dark_of(&closed, "wall");
+        assert!(!inside.is_empty() && inside.iter().all(|&d| d == (true, false)), "{inside:?}");
+        let on_the_wall = "usemtl glass\nv 1 0 0.9\nv 3 0 0.9\nv 3 0 2.3\nv 1 0 2.3\nf -1 -2 -3 -4\n";
+        let scene = scene_of(&dir.join("room-with-pane"), &(obj + on_the_wall));
+        assert!(dark_of(&scene, "wall").iter().all(|&d| d == (false, false)));
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
