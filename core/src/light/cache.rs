@@ -24,7 +24,7 @@ use crate::sky::SkyPatches;
 
 const MAGIC: &[u8; 8] = b"HELIOLT\0";
 /// Bump when the model or its layout changes.
-const FORMAT: u32 = 11;
+const FORMAT: u32 = 12;
 
 /// What happened to the cache.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -465,6 +465,10 @@ fn check_payload((len, checksum): (u64, u64), read_len: u64, read_checksum: u64)
 pub(crate) struct Writer(pub Vec<u8>);
 
 impl Writer {
+    pub fn u8(&mut self, v: u8) {
+        self.0.push(v);
+    }
+
     pub fn u16(&mut self, v: u16) {
         self.0.extend_from_slice(&v.to_le_bytes());
     }
@@ -561,6 +565,10 @@ impl Reader<'_> {
         let (head, tail) = self.0.split_at(n);
         self.0 = tail;
         Some(head)
+    }
+
+    pub fn u8(&mut self) -> Option<u8> {
+        self.take(1).map(|b| b[0])
     }
 
     pub fn u16(&mut self) -> Option<u16> {
@@ -664,7 +672,9 @@ impl LightModel {
 
 impl Landings {
     /// Each run as its side's step from the last and its length; the
-    /// shares run-length coded (most are 1/rays); the points as they are.
+    /// shares run-length coded (most are 1/rays); the points per run, each
+    /// coordinate its points share (on a patch square to an axis, as most
+    /// of a building's are, one of the three) written once.
     fn write(&self, w: &mut Writer) {
         let (runs, shares, points) = self.parts();
         w.u32(runs.len() as u32);
@@ -686,7 +696,17 @@ impl Landings {
             w.varint(count);
             w.f32(value);
         }
-        points.iter().flatten().for_each(|&c| w.u16(c));
+        let mut start = 0;
+        for &(_, end) in runs {
+            let run = &points[start..end as usize];
+            let shared: [bool; 3] = std::array::from_fn(|axis| run.iter().all(|p| p[axis] == run[0][axis]));
+            w.u8(shared.iter().enumerate().map(|(axis, &s)| u8::from(s) << axis).sum());
+            (0..3).filter(|&axis| shared[axis]).for_each(|axis| w.u16(run[0][axis]));
+            for point in run {
+                (0..3).filter(|&axis| !shared[axis]).for_each(|axis| w.u16(point[axis]));
+            }
+            start = end as usize;
+        }
     }
 
     fn read(r: &mut Reader) -> Option<Self> {
@@ -708,10 +728,29 @@ impl Landings {
             }
             shares.extend(std::iter::repeat_n(value, repeat));
         }
-        if shares.len() != total || r.0.len() < total * 6 {
+        if shares.len() != total {
             return None;
         }
-        let points = (0..total).map(|_| Some([r.u16()?, r.u16()?, r.u16()?])).collect::<Option<Vec<_>>>()?;
+        let mut points = Vec::with_capacity(total);
+        let mut start = 0;
+        for &(_, end) in &runs {
+            if end < start || end as usize > total {
+                return None;
+            }
+            let shared = r.u8().filter(|&bits| bits < 8)?;
+            let mut first = [0; 3];
+            for axis in (0..3).filter(|&axis| shared & (1 << axis) != 0) {
+                first[axis] = r.u16()?;
+            }
+            for _ in start..end {
+                let mut point = first;
+                for axis in (0..3).filter(|&axis| shared & (1 << axis) == 0) {
+                    point[axis] = r.u16()?;
+                }
+                points.push(point);
+            }
+            start = end;
+        }
         Self::from_parts(runs, shares, points)
     }
 }
@@ -739,23 +778,40 @@ impl SensorGeometry {
 mod tests {
     use super::*;
 
-    /// A sensor's landings read back as written; a cut payload is refused.
+    /// A sensor's landings read back as written, the points on a flat
+    /// patch in two coordinates each and those on a tilted one in three; a
+    /// cut payload is refused.
     #[test]
     fn landings_are_read_back_as_written() {
         use super::super::landings::PatchBox;
-        let boxes = vec![PatchBox::around(&[[glam::Vec3::ZERO, glam::Vec3::X, glam::Vec3::Y]]); 4];
+        let mut boxes = vec![PatchBox::around(&[[glam::Vec3::ZERO, glam::Vec3::X, glam::Vec3::Y]]); 4];
+        boxes[3] = PatchBox::around(&[[glam::Vec3::ZERO, glam::Vec3::new(1.0, 0.0, 1.0), glam::Vec3::new(0.0, 1.0, 1.0)]]);
         let p = |x: f64, y: f64| DVec3::new(x, y, 0.0);
-        let raw = vec![(5, 0.5, p(0.1, 0.2)), (1, 0.25, p(0.3, 0.3)), (5, 0.5, p(0.9, 0.05)), (2, 0.125, p(0.0, 1.0))];
+        let tilted = |x: f64, y: f64| DVec3::new(x, y, x + y);
+        let raw = vec![
+            (5, 0.5, p(0.1, 0.2)),
+            (1, 0.25, p(0.3, 0.3)),
+            (5, 0.5, p(0.9, 0.05)),
+            (2, 0.125, p(0.0, 1.0)),
+            (7, 0.5, tilted(0.2, 0.1)),
+            (7, 0.5, tilted(0.4, 0.5)),
+        ];
         let landings = Landings::new(raw, &boxes);
         let sides: Vec<(u32, usize)> = landings.by_side().map(|(side, shares, _)| (side, shares.len())).collect();
-        assert_eq!(sides, [(1, 1), (2, 1), (5, 2)]);
+        assert_eq!(sides, [(1, 1), (2, 1), (5, 2), (7, 2)]);
         let mut w = Writer::default();
         landings.write(&mut w);
+        // Runs: count, then a side step and an end step each; shares: count,
+        // then 0.25, 0.125 and 0.5 four times, each a count and the value;
+        // points: per run its shared axes, then sides 1 and 2 one point
+        // each wholly shared, side 5 two sharing z, side 7 two sharing none.
+        let points = 4 + 6 + 6 + (2 + 2 * 4) + 2 * 6;
+        assert_eq!(w.0.len(), (4 + 4 * 2) + (4 + 3 * 5) + points);
         let mut r = Reader(&w.0);
         assert_eq!(Landings::read(&mut r), Some(landings.clone()));
         assert!(r.is_empty());
         assert!(Landings::read(&mut Reader(&w.0[..w.0.len() - 1])).is_none(), "a cut payload is refused");
-        assert!(landings.fits(6) && !landings.fits(5));
+        assert!(landings.fits(8) && !landings.fits(7));
     }
 
     /// Rows read back bit for bit: shares counted in rays of a power of
