@@ -8,6 +8,7 @@
 //! receiver has its own seeded generator, so results do not depend on
 //! threads.
 
+use std::collections::HashMap;
 use std::sync::Arc;
 
 use glam::DVec3;
@@ -120,6 +121,17 @@ struct Aiming<'a> {
     hemisphere: usize,
 }
 
+/// Where a receiver's aimed rays start.
+#[derive(Clone, Copy)]
+enum Eyes<'a> {
+    /// Points spread by area over a patch side's triangles (with their
+    /// cumulative areas), lifted off it.
+    Spread { triangles: &'a [([DVec3; 3], f64)], lift: DVec3 },
+    /// A sensor's measuring points, taken in turn: a near window's
+    /// triangles' solid angles from each are found once, not per ray.
+    Fixed(&'a [DVec3]),
+}
+
 /// How far in front of a patch side (m) a vertex of a window must lie for
 /// the side to aim at it: a wall around its own window sees none of it.
 const WINDOW_IN_FRONT: f64 = 1e-4;
@@ -135,15 +147,23 @@ impl WindowTarget {
     /// (pdf r²/(A cos)); near it, where that weight would swing with 1/r²,
     /// a direction drawn evenly over the solid angle of one of its
     /// triangles, picked by solid angle with `within` (a stratified
-    /// uniform number). `None` where the window fills no solid angle.
-    fn aim(&self, eye: DVec3, near: bool, within: f64, rng: &mut Rng) -> Option<(DVec3, f64)> {
+    /// uniform number); `seen`: those solid angles, where already found.
+    /// `None` where the window fills no solid angle.
+    fn aim(&self, eye: DVec3, near: bool, within: f64, seen: Option<&[f64]>, rng: &mut Rng) -> Option<(DVec3, f64)> {
         if !near {
             let to = sample_area(&self.triangles, rng) - eye;
             let r2 = to.length_squared();
             let dir = to / r2.sqrt();
             return Some((dir, self.area * self.normal.dot(dir).abs() / r2));
         }
-        let solid_angles: Vec<f64> = self.solid_angles(eye).collect();
+        let found: Vec<f64>;
+        let solid_angles = match seen {
+            Some(seen) => seen,
+            None => {
+                found = self.solid_angles(eye).collect();
+                &found
+            }
+        };
         let total: f64 = solid_angles.iter().sum();
         if total <= 0.0 {
             return None;
@@ -368,21 +388,23 @@ impl LightModel {
             self.follow(point, dir, 1.0, 0, Way::START, &not_aimed, &mut coefficients, &mut hits);
         }
         let aiming = Aiming { normal, aimed: &aimed, targets, rays: self.settings.window_rays_per_patch, hemisphere };
-        self.aim_at_windows(&aiming, &mut rng, |rng| sample_area(&triangles, rng) + normal * SURFACE_OFFSET, &mut coefficients);
+        self.aim_at_windows(&aiming, &mut rng, Eyes::Spread { triangles: &triangles, lift: normal * SURFACE_OFFSET }, &mut coefficients);
         Gather::from_raw(coefficients, &hits, hemisphere)
     }
 
-    /// Traces `aiming.rays` rays aimed at its windows from points `point`
-    /// draws, adding the sky straight through each window to
-    /// `coefficients`: stratified over the windows by their odds, and
-    /// within a near window by the rest of the stratum; each ray weighted
+    /// Traces `aiming.rays` rays aimed at its windows from `eyes`, adding
+    /// the sky straight through each window to `coefficients`: stratified
+    /// over the windows by their odds, and within a near window by the rest
+    /// of the stratum; each ray weighted
     /// by cos·Ω/(π P) for the solid angle Ω its direction was drawn from
     /// and the odds P of its window, in units of the receiver's
     /// `aiming.hemisphere` hemisphere rays.
-    fn aim_at_windows(&self, aiming: &Aiming, rng: &mut Rng, mut point: impl FnMut(&mut Rng) -> DVec3, coefficients: &mut Vec<(u32, f64)>) {
+    fn aim_at_windows(&self, aiming: &Aiming, rng: &mut Rng, eyes: Eyes, coefficients: &mut Vec<(u32, f64)>) {
         let Aiming { normal, aimed, targets, rays, hemisphere } = *aiming;
         let odds_total: f64 = aimed.iter().map(|a| a.odds).sum();
         let mut ignored = Vec::new();
+        // Per fixed eye and near window, its triangles' solid angles.
+        let mut seen: HashMap<(usize, usize), Vec<f64>> = HashMap::new();
         for j in (0..rays).filter(|_| !aimed.is_empty()) {
             let mut pick = (j as f64 + rng.next_f64()) / rays as f64 * odds_total;
             let aim = aimed
@@ -394,8 +416,14 @@ impl LightModel {
                 .unwrap_or(aimed.last().expect("aimed is not empty"));
             let within = ((pick + aim.odds) / aim.odds).clamp(0.0, 1.0);
             let target = &targets[aim.target];
-            let point = point(rng);
-            let Some((dir, solid_angle)) = target.aim(point, aim.near, within, rng) else { continue };
+            let (point, eye) = match eyes {
+                Eyes::Spread { triangles, lift } => (sample_area(triangles, rng) + lift, None),
+                Eyes::Fixed(points) => (points[j % points.len()], Some(j % points.len())),
+            };
+            let angles = eye
+                .filter(|_| aim.near)
+                .map(|eye| &seen.entry((eye, aim.target)).or_insert_with(|| target.solid_angles(point).collect())[..]);
+            let Some((dir, solid_angle)) = target.aim(point, aim.near, within, angles, rng) else { continue };
             let cos_here = normal.dot(dir);
             if cos_here <= 0.0 {
                 continue;
@@ -515,16 +543,7 @@ impl LightModel {
         let landings = Landings::new(bounce, &self.patch_boxes);
         let rays = bounce_rays + trace(more_per_point, &mut coefficients, &mut hits, &mut rng);
         let aiming = Aiming { normal, aimed: &aimed, targets, rays: self.settings.window_rays_per_sensor, hemisphere: rays };
-        let mut next = 0;
-        self.aim_at_windows(
-            &aiming,
-            &mut rng,
-            |_| {
-                next += 1;
-                points[(next - 1) % points.len()]
-            },
-            &mut coefficients,
-        );
+        self.aim_at_windows(&aiming, &mut rng, Eyes::Fixed(&points), &mut coefficients);
         SensorGeometry::new(Gather::from_raw(coefficients, &hits, rays), sun_points, normal, landings)
     }
 }
