@@ -25,12 +25,12 @@ const WINDOW_PROBE: f64 = 1e-3;
 /// glass at run time opens its shells).
 pub(super) fn dark_sides(scene: &Scene) -> Vec<bool> {
     let opaque = |material: u32| matches!(scene.materials[material as usize].kind, MaterialKind::Diffuse { .. });
-    // The opaque surfaces' triangles, and where each surface's start.
+    // The opaque surfaces' triangles, and where each surface's triangles begin there.
     let mut triangles = Vec::new();
     let mut vertices = Vec::new();
-    let mut first = vec![u32::MAX; scene.surfaces.len()];
+    let mut first = vec![None; scene.surfaces.len()];
     for (k, surface) in scene.surfaces.iter().enumerate().filter(|(_, s)| opaque(s.material)) {
-        first[k] = triangles.len() as u32;
+        first[k] = Some(triangles.len());
         for triangle in &scene.triangles[surface.triangles.start as usize..surface.triangles.end as usize] {
             triangles.push(triangle.vertices);
             vertices.push(triangle.file_vertices);
@@ -43,52 +43,53 @@ pub(super) fn dark_sides(scene: &Scene) -> Vec<bool> {
     let outward: Vec<i8> = scene
         .surfaces
         .iter()
-        .enumerate()
-        .map(|(k, surface)| {
-            if first[k] == u32::MAX {
-                return 0;
-            }
-            let mut common = None;
-            let own = first[k] as usize..first[k] as usize + surface.triangles.len();
-            for (&[a, b, c], &winding) in triangles[own.clone()].iter().zip(&shells.winding[own]) {
-                let way = (b - a).cross(c - a).dot(surface.normal);
-                let out = if way > 0.0 {
-                    winding
-                } else if way < 0.0 {
-                    -winding
-                } else {
-                    0
-                };
-                if out == 0 || common.is_some_and(|c| c != out) {
-                    return 0;
-                }
-                common = Some(out);
-            }
-            common.unwrap_or(0)
+        .zip(&first)
+        .map(|(surface, first)| {
+            let Some(first) = *first else { return 0 };
+            let own = first..first + surface.triangles.len();
+            agreed(
+                triangles[own.clone()]
+                    .iter()
+                    .zip(&shells.winding[own])
+                    .map(|(&[a, b, c], &winding)| as_seen_along((b - a).cross(c - a).dot(surface.normal), winding)),
+            )
         })
         .collect();
     let mesh = &scene.patches;
     let mut dark = vec![false; mesh.patches.len() * 2];
     for (p, patch) in mesh.patches.iter().enumerate() {
         // A cluster's surfaces must agree, each as it faces the patch's normal.
-        let ways = mesh.surfaces_of(p as u32).iter().map(|&s| {
-            let facing = scene.surfaces[s as usize].normal.dot(patch.normal);
-            if facing > 0.0 {
-                outward[s as usize]
-            } else if facing < 0.0 {
-                -outward[s as usize]
-            } else {
-                0
-            }
-        });
-        let mut ways = ways.peekable();
-        let Some(&way) = ways.peek() else { continue };
-        if way != 0 && ways.all(|w| w == way) {
+        let way = agreed(
+            mesh.surfaces_of(p as u32)
+                .iter()
+                .map(|&s| as_seen_along(scene.surfaces[s as usize].normal.dot(patch.normal), outward[s as usize])),
+        );
+        if way != 0 {
             // Outside along the normal: the back side looks in.
             dark[side_of(p as u32, way > 0) as usize] = true;
         }
     }
     dark
+}
+
+/// `way` (±1, or 0) as seen from a direction that makes the cosine
+/// `facing` with the one it was given along: turned where that is
+/// opposite, 0 where it is square to it.
+fn as_seen_along(facing: f32, way: i8) -> i8 {
+    if facing > 0.0 {
+        way
+    } else if facing < 0.0 {
+        -way
+    } else {
+        0
+    }
+}
+
+/// The one way all of `ways` go, or 0 where one is 0, two differ or
+/// there are none.
+fn agreed(mut ways: impl Iterator<Item = i8>) -> i8 {
+    let Some(first) = ways.next() else { return 0 };
+    if ways.all(|way| way == first) { first } else { 0 }
 }
 
 /// Takes out of `shells` every shell that has a window (a surface whose
