@@ -55,11 +55,13 @@ fn test_room_loads_with_its_six_windows() {
     // Walls, floor and ceiling: 4·3·2 + 2·6·3 + 2·4·6 = 108 m² of surface, less 4.59 of glass.
     let opaque: f32 = scene.surfaces.iter().filter(|s| !scene.material(s.material).kind.transmits()).map(|s| s.area).sum();
     assert!((opaque - (108.0 - 4.59)).abs() < 1e-3, "{opaque}");
-    // Patches cover every surface exactly and are no larger than the grid cell.
+    // Patches cover every surface exactly and are no larger than a grid cell
+    // and a half (a sliver along a wall's edge joins the cell beside it).
     let patch_area: f32 = scene.patches.patches.iter().map(|p| p.area).sum();
     let surface_area: f32 = scene.surfaces.iter().map(|s| s.area).sum();
     assert!((patch_area - surface_area).abs() < 1e-3);
-    assert!(scene.patches.patches.iter().all(|p| p.area <= 0.25 + 1e-5));
+    assert!(scene.patches.patches.iter().all(|p| p.area <= 1.5 * 0.25 + 1e-5));
+    assert!(scene.patches.patches.iter().filter(|p| p.area > 0.25 + 1e-5).count() > 0, "slivers joined the cells beside them");
     // The floor (4 × 6 m) alone is 96 patches of 0.5 m.
     let floor = scene.materials.iter().position(|m| m.name == "floor").unwrap() as u32;
     assert_eq!(scene.patches.patches.iter().filter(|p| p.material == floor).count(), 96);

@@ -11,6 +11,12 @@
 //! the pieces of triangles inside the cell are its render triangles.
 //! Triangles smaller than their cell are not cut: they join the cell that
 //! holds their centroid (small coplanar triangles gather into patches).
+//! A cell holding less than a quarter of its area of the surface (the
+//! strip along a surface's edge, a frame's profile, the corner a cut plane
+//! leaves) joins a neighbouring cell on the same sides of every cut, as
+//! long as the patch stays within two cells each way and one and a half
+//! cells' area ([`merge_small_cells`]): real exports are full of such
+//! pieces.
 //!
 //! A window's plane also cuts the surfaces that pass through it near the
 //! window — reveals, sills, lintels, frames, the floor under a door: the
@@ -426,7 +432,7 @@ pub fn subdivide(
         let bounds = super::bounds(tris);
         let planes: Vec<&CutPlane> = cuts.iter().filter(|c| c.cuts(tris, bounds)).chain(&contacts[index]).collect();
         // Per leaf cell and side of the cutting planes: its pieces.
-        let mut cells: BTreeMap<(i64, i64, u64), Vec<[Vec3; 3]>> = BTreeMap::new();
+        let mut cells: BTreeMap<CellKey, Pieces> = BTreeMap::new();
         let mut add = |cell: Cell, polygon: Vec<Vec3>| {
             split_by_planes(polygon, &planes, &mut |above, part| {
                 let pieces = cells.entry((cell.i, cell.j, above)).or_default();
@@ -468,7 +474,7 @@ pub fn subdivide(
                 }
             }
         }
-        for pieces in cells.into_values().filter(|p| !p.is_empty()) {
+        for pieces in merge_small_cells(&tree, cells) {
             let start = mesh.triangles.len() as u32;
             let mut area = 0.0;
             let mut moment = Vec3::ZERO;
@@ -490,6 +496,92 @@ pub fn subdivide(
         surface.patches = first_patch..mesh.patches.len() as u32;
     }
     mesh
+}
+
+/// A leaf cell's pieces of a surface on one side of each cutting plane: its
+/// column, row and the planes it lies above ([`split_by_planes`]).
+type CellKey = (i64, i64, u64);
+/// Render triangles.
+type Pieces = Vec<[Vec3; 3]>;
+
+/// A cell holding less of its surface than this share of the cell's area
+/// joins a neighbour ([`merge_small_cells`]). (At a half, SampleHouse's
+/// rooms read 1% darker against Radiance than with no cell joined; at a
+/// quarter they read as before, FZK-Haus's closer: median 1.8 → 1.3%.)
+const SMALL_CELL: f32 = 0.25;
+/// A cell joins a neighbour only while together they hold no more than this
+/// share of the larger cell's area.
+const MERGED_CELLS: f32 = 1.5;
+
+/// A surface's leaf cells' pieces (per cell and side of the cutting planes)
+/// as patches: a cell holding little of the surface (its edge strip, a
+/// frame's profile, the corner a cut left) joins the neighbouring cell on
+/// the same sides of every cutting plane that holds the most, smallest cells
+/// first, while the patch so made stays within two cells each way and
+/// [`MERGED_CELLS`] of a cell's area. Slivers then stop counting as patches
+/// of their own (AC20-Institute-Var-2: 53,000 of 143,416 patches held under
+/// a quarter of a cell, 5% of the area), and no patch reaches far: joined
+/// without the bound, thin strips chained along a roof's underside from the
+/// sunlit eaves into FZK-Haus's attic (its gallery read 3× Radiance).
+fn merge_small_cells(tree: &Quadtree, cells: BTreeMap<CellKey, Pieces>) -> Vec<Pieces> {
+    let (keys, mut pieces): (Vec<CellKey>, Vec<Pieces>) = cells.into_iter().filter(|(_, p)| !p.is_empty()).unzip();
+    let index: HashMap<CellKey, usize> = keys.iter().enumerate().map(|(k, &key)| (key, k)).collect();
+    let cell_area = |(i, j, _): CellKey| tree.bounds(tree.leaf_at((i, j))).2.powi(2);
+    let mut area: Vec<f32> = pieces.iter().map(|p| p.iter().map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()).sum()).collect();
+    // Each group's cells' box in finest cells (i0, j0, i1, j1), and the largest cell's span.
+    let mut extent: Vec<([i64; 4], i64)> = keys
+        .iter()
+        .map(|&(i, j, _)| {
+            let span = tree.span(tree.leaf_at((i, j)));
+            ([i, j, i + span, j + span], span)
+        })
+        .collect();
+    let mut joined: Vec<usize> = (0..keys.len()).collect();
+    let root = |joined: &[usize], mut k: usize| {
+        while joined[k] != k {
+            k = joined[k];
+        }
+        k
+    };
+    let mut smallest_first: Vec<usize> = (0..keys.len()).filter(|&k| area[k] < SMALL_CELL * cell_area(keys[k])).collect();
+    smallest_first.sort_by(|&a, &b| area[a].total_cmp(&area[b]).then(a.cmp(&b)));
+    for k in smallest_first {
+        let (i, j, above) = keys[k];
+        let own = root(&joined, k);
+        if area[own] >= SMALL_CELL * cell_area(keys[k]) {
+            continue;
+        }
+        let own_leaf = tree.leaf_at((i, j));
+        let span = tree.span(own_leaf);
+        // Only a cell of the same size: where the quadtree steps, the light is not the finest's.
+        let neighbours = [(i - 1, j), (i + span, j), (i, j - 1), (i, j + span)].map(|at| {
+            let leaf = tree.leaf_at(at);
+            (leaf.level == own_leaf.level).then(|| index.get(&(leaf.i, leaf.j, above)).map(|&n| (n, root(&joined, n)))).flatten()
+        });
+        let best = neighbours
+            .into_iter()
+            .flatten()
+            .filter(|&(n, group)| {
+                let ([a0, b0, a1, b1], s) = extent[group];
+                let ([c0, d0, c1, d1], t) = extent[own];
+                let side = 2 * s.max(t);
+                group != own
+                    && area[group] + area[own] <= MERGED_CELLS * cell_area(keys[k]).max(cell_area(keys[n]))
+                    && a1.max(c1) - a0.min(c0) <= side
+                    && b1.max(d1) - b0.min(d0) <= side
+            })
+            .max_by(|a, b| area[a.1].total_cmp(&area[b.1]).then(b.1.cmp(&a.1)));
+        if let Some((_, group)) = best {
+            joined[own] = group;
+            area[group] += area[own];
+            let ([a0, b0, a1, b1], s) = extent[group];
+            let ([c0, d0, c1, d1], t) = extent[own];
+            extent[group] = ([a0.min(c0), b0.min(d0), a1.max(c1), b1.max(d1)], s.max(t));
+            let moved = std::mem::take(&mut pieces[own]);
+            pieces[group].extend(moved);
+        }
+    }
+    pieces.into_iter().enumerate().filter(|(k, _)| root(&joined, *k) == *k).map(|(_, p)| p).collect()
 }
 
 /// Two in-plane axes: horizontal and up-slope for walls, east and north for
@@ -566,6 +658,8 @@ mod tests {
         assert!((total - 12.0).abs() < 1e-4);
     }
 
+    /// A cell holding a quarter of its area of the surface or more stays a
+    /// patch of its own ([`SMALL_CELL`]).
     #[test]
     fn a_partial_cell_keeps_its_share() {
         let tris = quad(1.2, 0.5);
@@ -576,6 +670,45 @@ mod tests {
         areas.sort_by(f32::total_cmp);
         assert_eq!(areas.len(), 3);
         assert!((areas[0] - 0.1).abs() < 1e-5 && (areas[2] - 0.25).abs() < 1e-5);
+    }
+
+    /// A wall 4.1 m wide: its 10 cm edge strip joins the cell beside it
+    /// rather than being a patch of its own. A window plane at x = 1.1 m
+    /// leaves a 10 cm piece of a cell on its near side: that piece joins the
+    /// cell beside it on the same side, never the rest of its own cell
+    /// beyond the plane.
+    #[test]
+    fn small_cells_join_a_neighbour_on_the_same_side_of_every_cut() {
+        let patches = |width: f32, cuts: &[CutPlane]| {
+            let tris = quad(width, 0.5);
+            let mut surfaces = vec![surface_of(&tris)];
+            let large = LargeFaces::new(&tris, &surfaces, f32::INFINITY);
+            let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::uniform(0.5), &[false], cuts, &large);
+            let mut spans: Vec<(f32, f32, f32)> = mesh
+                .patches
+                .iter()
+                .map(|p| {
+                    let xs = mesh.triangles[p.triangles.start as usize..p.triangles.end as usize].iter().flatten().map(|v| v.x);
+                    (xs.clone().fold(f32::MAX, f32::min), xs.fold(f32::MIN, f32::max), p.area)
+                })
+                .collect();
+            spans.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let total: f32 = spans.iter().map(|s| s.2).sum();
+            assert!((total - width * 0.5).abs() < 1e-5, "area kept: {total}");
+            spans
+        };
+        let close = |a: f32, b: f32| (a - b).abs() < 1e-4;
+        let strip = patches(4.1, &[]);
+        assert_eq!(strip.len(), 8, "{strip:?}");
+        let last = strip[7];
+        assert!(close(last.0, 3.5) && close(last.1, 4.1) && close(last.2, 0.3), "{last:?}");
+        let window = CutPlane { normal: Vec3::X, offset: 1.1, near: (Vec3::splat(-10.0), Vec3::splat(10.0)) };
+        let cut = patches(2.0, &[window]);
+        let expected = [(0.0, 0.5, 0.25), (0.5, 1.1, 0.3), (1.1, 1.5, 0.2), (1.5, 2.0, 0.25)];
+        assert_eq!(cut.len(), expected.len(), "{cut:?}");
+        for (got, want) in cut.iter().zip(expected) {
+            assert!(close(got.0, want.0) && close(got.1, want.1) && close(got.2, want.2), "{got:?} against {want:?}");
+        }
     }
 
     #[test]
