@@ -510,32 +510,30 @@ type Pieces = Vec<[Vec3; 3]>;
 /// quarter they read as before, FZK-Haus's closer: median 1.8 → 1.3%.)
 const SMALL_CELL: f32 = 0.25;
 /// A cell joins a neighbour only while together they hold no more than this
-/// share of the larger cell's area.
+/// share of the cell's area.
 const MERGED_CELLS: f32 = 1.5;
 
 /// A surface's leaf cells' pieces (per cell and side of the cutting planes)
 /// as patches: a cell holding little of the surface (its edge strip, a
-/// frame's profile, the corner a cut left) joins the neighbouring cell on
-/// the same sides of every cutting plane that holds the most, smallest cells
-/// first, while the patch so made stays within two cells each way and
-/// [`MERGED_CELLS`] of a cell's area. Slivers then stop counting as patches
-/// of their own (AC20-Institute-Var-2: 53,000 of 143,416 patches held under
-/// a quarter of a cell, 5% of the area), and no patch reaches far: joined
-/// without the bound, thin strips chained along a roof's underside from the
-/// sunlit eaves into FZK-Haus's attic (its gallery read 3× Radiance).
+/// frame's profile, the corner a cut left) joins the neighbouring cell of
+/// its own size on the same sides of every cutting plane that holds the
+/// most, smallest cells first, while the patch so made stays within two
+/// cells each way and [`MERGED_CELLS`] of a cell's area: no patch grows past
+/// what the sizing allows where it lies. Slivers then stop counting as
+/// patches of their own (AC20-Institute-Var-2: 53,000 of 143,416 patches
+/// held under a quarter of a cell, 5% of the area), and no patch reaches
+/// far: joined without the bound, thin strips chained along a roof's
+/// underside from the sunlit eaves into FZK-Haus's attic (its gallery read
+/// 3× Radiance).
 fn merge_small_cells(tree: &Quadtree, cells: BTreeMap<CellKey, Pieces>) -> Vec<Pieces> {
     let (keys, mut pieces): (Vec<CellKey>, Vec<Pieces>) = cells.into_iter().filter(|(_, p)| !p.is_empty()).unzip();
     let index: HashMap<CellKey, usize> = keys.iter().enumerate().map(|(k, &key)| (key, k)).collect();
-    let cell_area = |(i, j, _): CellKey| tree.bounds(tree.leaf_at((i, j))).2.powi(2);
+    let leaves: Vec<Cell> = keys.iter().map(|&(i, j, _)| tree.leaf_at((i, j))).collect();
+    let cell_area = |k: usize| tree.bounds(leaves[k]).2.powi(2);
     let mut area: Vec<f32> = pieces.iter().map(|p| p.iter().map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()).sum()).collect();
-    // Each group's cells' box in finest cells (i0, j0, i1, j1), and the largest cell's span.
-    let mut extent: Vec<([i64; 4], i64)> = keys
-        .iter()
-        .map(|&(i, j, _)| {
-            let span = tree.span(tree.leaf_at((i, j)));
-            ([i, j, i + span, j + span], span)
-        })
-        .collect();
+    // Each group's cells' box in finest cells: (i0, j0, i1, j1).
+    let mut extent: Vec<[i64; 4]> =
+        leaves.iter().map(|&leaf| [leaf.i, leaf.j, leaf.i + tree.span(leaf), leaf.j + tree.span(leaf)]).collect();
     let mut joined: Vec<usize> = (0..keys.len()).collect();
     let root = |joined: &[usize], mut k: usize| {
         while joined[k] != k {
@@ -543,40 +541,33 @@ fn merge_small_cells(tree: &Quadtree, cells: BTreeMap<CellKey, Pieces>) -> Vec<P
         }
         k
     };
-    let mut smallest_first: Vec<usize> = (0..keys.len()).filter(|&k| area[k] < SMALL_CELL * cell_area(keys[k])).collect();
+    let mut smallest_first: Vec<usize> = (0..keys.len()).filter(|&k| area[k] < SMALL_CELL * cell_area(k)).collect();
     smallest_first.sort_by(|&a, &b| area[a].total_cmp(&area[b]).then(a.cmp(&b)));
     for k in smallest_first {
-        let (i, j, above) = keys[k];
         let own = root(&joined, k);
-        if area[own] >= SMALL_CELL * cell_area(keys[k]) {
+        if area[own] >= SMALL_CELL * cell_area(k) {
             continue;
         }
-        let own_leaf = tree.leaf_at((i, j));
-        let span = tree.span(own_leaf);
-        // Only a cell of the same size: where the quadtree steps, the light is not the finest's.
+        let (Cell { i, j, level }, above) = (leaves[k], keys[k].2);
+        let span = tree.span(leaves[k]);
         let neighbours = [(i - 1, j), (i + span, j), (i, j - 1), (i, j + span)].map(|at| {
             let leaf = tree.leaf_at(at);
-            (leaf.level == own_leaf.level).then(|| index.get(&(leaf.i, leaf.j, above)).map(|&n| (n, root(&joined, n)))).flatten()
+            (leaf.level == level).then(|| index.get(&(leaf.i, leaf.j, above)).map(|&n| root(&joined, n))).flatten()
         });
-        let best = neighbours
-            .into_iter()
-            .flatten()
-            .filter(|&(n, group)| {
-                let ([a0, b0, a1, b1], s) = extent[group];
-                let ([c0, d0, c1, d1], t) = extent[own];
-                let side = 2 * s.max(t);
-                group != own
-                    && area[group] + area[own] <= MERGED_CELLS * cell_area(keys[k]).max(cell_area(keys[n]))
-                    && a1.max(c1) - a0.min(c0) <= side
-                    && b1.max(d1) - b0.min(d0) <= side
-            })
-            .max_by(|a, b| area[a.1].total_cmp(&area[b.1]).then(b.1.cmp(&a.1)));
-        if let Some((_, group)) = best {
+        let fits = |group: usize| {
+            let ([a0, b0, a1, b1], [c0, d0, c1, d1]) = (extent[group], extent[own]);
+            group != own
+                && area[group] + area[own] <= MERGED_CELLS * cell_area(k)
+                && a1.max(c1) - a0.min(c0) <= 2 * span
+                && b1.max(d1) - b0.min(d0) <= 2 * span
+        };
+        let best =
+            neighbours.into_iter().flatten().filter(|&group| fits(group)).max_by(|&a, &b| area[a].total_cmp(&area[b]).then(b.cmp(&a)));
+        if let Some(group) = best {
             joined[own] = group;
             area[group] += area[own];
-            let ([a0, b0, a1, b1], s) = extent[group];
-            let ([c0, d0, c1, d1], t) = extent[own];
-            extent[group] = ([a0.min(c0), b0.min(d0), a1.max(c1), b1.max(d1)], s.max(t));
+            let ([a0, b0, a1, b1], [c0, d0, c1, d1]) = (extent[group], extent[own]);
+            extent[group] = [a0.min(c0), b0.min(d0), a1.max(c1), b1.max(d1)];
             let moved = std::mem::take(&mut pieces[own]);
             pieces[group].extend(moved);
         }
