@@ -248,7 +248,7 @@ impl SunHours {
     pub fn key(model: &LightModel, site: &Site, shades: bool) -> u64 {
         let scene = &model.scene;
         let mut hash = Fnv::new();
-        hash.u64(cache::key(scene, &model.settings)).u64(u64::from(FORMAT));
+        hash.u64(model.cache_key()).u64(u64::from(FORMAT));
         for material in &scene.materials {
             match &material.kind {
                 MaterialKind::Diffuse { reflectance } => reflectance.0.iter().fold(hash.u64(0), |h, c| h.u64(u64::from(c.to_bits()))),

@@ -140,14 +140,16 @@ pub fn precompute_cached(
 ) -> Result<(LightModel, CacheOutcome), String> {
     settings.check()?;
     let key = key(&scene, &settings);
-    through_cache(
+    let (model, outcome) = through_cache(
         dir,
         &format!("{key:016x}"),
         key,
         |payload| LightModel::from_payload(scene.clone(), settings, payload),
         || LightModel::precompute_with_progress(scene.clone(), settings, progress),
         LightModel::payload,
-    )
+    )?;
+    model.cache_key.get_or_init(|| key);
+    Ok((model, outcome))
 }
 
 /// Where the cache file `name` lives in `dir`.

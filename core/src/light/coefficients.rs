@@ -138,7 +138,7 @@ impl LightModel {
             return (self.sensor_coefficients(), CacheOutcome::Skipped("too large to keep".into()));
         }
         let mut hash = Fnv::new();
-        hash.u64(cache::key(&self.scene, &self.settings)).u64(u64::from(FORMAT));
+        hash.u64(self.cache_key()).u64(u64::from(FORMAT));
         for side in 0..sides {
             match self.side_reflectance(side) {
                 Some(rho) => rho.iter().fold(hash.u64(1), |h, r| h.f64(*r)),

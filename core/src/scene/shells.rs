@@ -81,8 +81,9 @@ pub(crate) struct Shells {
 }
 
 /// The closed shells among `triangles`, whose edges are [`Edges`]: sets
-/// of triangles joined edge to edge, each edge met by exactly one other (no open edge, no place where three or more faces
-/// meet), their windings made to agree across each edge and then turned
+/// of triangles joined edge to edge, each edge met by exactly one other
+/// (no open edge, no place where three or more faces meet), their
+/// windings made to agree across each edge and then turned
 /// outward (the solid they bound has a positive volume). Turned outward,
 /// the faces toward the light shade the shell's inside too: a point within
 /// the solid, or within a closed room modelled as one, sees the light
