@@ -102,8 +102,8 @@ pub struct Scene {
     /// Axis-aligned bounds of all triangles: (min, max).
     pub bounds: (Vec3, Vec3),
     /// The bounds of what the scene is about: its windows and sensors (the
-    /// whole model's bounds when it has neither). Patches are finest around
-    /// it, and views frame it rather than a site's ground.
+    /// whole model's bounds when it has neither): views frame it rather
+    /// than a site's ground.
     pub focus: (Vec3, Vec3),
 }
 
@@ -306,15 +306,23 @@ fn build(
     let windows = surfaces::windows(&triangles, &surfaces, &materials);
     let sensors = sensors::sensors(&parsed)?;
     // Patches are finest around the windows and the sensors (see `patches`).
-    let window_corners = windows.iter().flat_map(|w| {
-        let range = surfaces[w.surface as usize].triangles.clone();
-        triangles[range.start as usize..range.end as usize].iter().flat_map(|t| t.vertices)
-    });
-    let focus = window_corners
-        .chain(sensors.iter().map(|s| s.position))
-        .fold(None, |b: Option<(Vec3, Vec3)>, p| Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p)))));
-    let sizing =
-        if parsed.adaptive_patches { PatchSizing::around(parsed.patch_size, focus) } else { PatchSizing::uniform(parsed.patch_size) };
+    let window_bounds: Vec<(Vec3, Vec3)> = windows
+        .iter()
+        .map(|w| {
+            let range = surfaces[w.surface as usize].triangles.clone();
+            bounds(&triangles[range.start as usize..range.end as usize])
+        })
+        .collect();
+    let sensor_points: Vec<Vec3> = sensors.iter().map(|s| s.position).collect();
+    // What views frame: the windows and the sensors.
+    let focus =
+        window_bounds.iter().copied().chain(sensor_points.iter().map(|&p| (p, p))).reduce(|(lo, hi), (a, b)| (lo.min(a), hi.max(b)));
+    // Patches are finest around the sensors and the windows that light them (see `patches`).
+    let sizing = if parsed.adaptive_patches {
+        PatchSizing::around(parsed.patch_size, &sensor_points, &window_bounds)
+    } else {
+        PatchSizing::uniform(parsed.patch_size)
+    };
     // Clutter gathers into clusters; windows keep patches of their own.
     let clusterable: Vec<bool> =
         surfaces.iter().map(|s| matches!(materials[s.material as usize].kind, MaterialKind::Diffuse { .. })).collect();

@@ -3,10 +3,12 @@
 //! square cells in its plane, whose finest cells are the `patch_size` grid
 //! laid from the surface's corner. A cell is split while it is larger than
 //! the size allowed where it lies ([`PatchSizing`]): `patch_size` in the
-//! *focus* (the box around the windows and the sensors, with a margin), and
-//! growing with the distance from it (a quarter of that distance, at most
-//! 64 × `patch_size`). So a room keeps today's grid, while the far ground,
-//! the site's context and the outside of the building far from its windows
+//! *focus* (around the sensors and the windows within a few metres of
+//! them, with a margin; around all the windows when there are no
+//! sensors), and growing with the distance from it (a quarter of that
+//! distance, at most 64 × `patch_size`). So a room keeps today's grid,
+//! while the far ground, the site's context, the outside of the building
+//! far from its windows and the wings and storeys where no sensor reads
 //! get a few large patches. A patch is one leaf cell's part of the surface;
 //! the pieces of triangles inside the cell are its render triangles.
 //! Triangles smaller than their cell are not cut: they join the cell that
@@ -126,39 +128,98 @@ const SLIVER_AREA: f32 = 1e-8;
 const GROWTH: f32 = 0.25;
 /// The largest patch side, in finest sizes.
 const COARSEST: f32 = 64.0;
-/// The focus box reaches this far (m) beyond the windows and sensors.
+/// The focus reaches this far (m) beyond the windows and sensors.
 const FOCUS_MARGIN: f32 = 1.5;
+/// Sensors in one cube of this side (m) share one focus box.
+const SENSOR_CUBE: f32 = 2.0;
+/// A window lights the sensors when it lies within this distance (m) of
+/// one: the windows of a sensor's room.
+const WINDOW_REACH: f32 = 5.0;
+
+/// An axis-aligned box: (min, max).
+type Bounds = (Vec3, Vec3);
 
 /// The patch side allowed at each place: `finest` in the focus, larger with
 /// the distance from it.
-#[derive(Debug, Clone, Copy, PartialEq)]
+///
+/// The focus is where the readings are made and the light they see comes
+/// in: boxes around the sensors (one per [`SENSOR_CUBE`] they occupy) and
+/// around each window within [`WINDOW_REACH`] of them. Light far from every
+/// sensor reaches them only after bounces that average it, so a wing or a
+/// storey without sensors is coarse: a building with one room of sensors
+/// does not pay for the rest of it. A scene without sensors focuses on
+/// the box around all its windows (what the viewer shows lit).
+#[derive(Debug, Clone, PartialEq)]
 pub struct PatchSizing {
     /// `patch_size`: the side of the finest patches, m.
     pub finest: f32,
-    /// The box (min, max) where patches are finest; `None`: finest everywhere.
-    pub focus: Option<(Vec3, Vec3)>,
+    /// The boxes where patches are finest, margin included; empty: finest
+    /// everywhere.
+    focus: Vec<Bounds>,
 }
 
 impl PatchSizing {
     /// Finest everywhere: the uniform `size` grid.
     pub fn uniform(size: f32) -> Self {
-        Self { finest: size, focus: None }
+        Self { finest: size, focus: Vec::new() }
     }
 
-    /// Finest within [`FOCUS_MARGIN`] of the box `focus` (around the
-    /// windows and the sensors); finest everywhere without one.
-    pub fn around(size: f32, focus: Option<(Vec3, Vec3)>) -> Self {
-        Self { finest: size, focus: focus.map(|(lo, hi)| (lo - Vec3::splat(FOCUS_MARGIN), hi + Vec3::splat(FOCUS_MARGIN))) }
+    /// Finest within [`FOCUS_MARGIN`] of the `sensors` and of the `windows`
+    /// (their bounds) that light them, or of the box around every window
+    /// when there is no sensor; finest everywhere with neither.
+    pub fn around(size: f32, sensors: &[Vec3], windows: &[Bounds]) -> Self {
+        let mut cubes: BTreeMap<[i32; 3], Bounds> = BTreeMap::new();
+        for &p in sensors {
+            let cube = (p / SENSOR_CUBE).floor().as_ivec3().to_array();
+            let (lo, hi) = cubes.entry(cube).or_insert((p, p));
+            (*lo, *hi) = (lo.min(p), hi.max(p));
+        }
+        let near_sensors: Vec<Bounds> = cubes.into_values().collect();
+        let mut focus = near_sensors.clone();
+        if near_sensors.is_empty() {
+            focus.extend(windows.iter().copied().reduce(|(lo, hi), (a, b)| (lo.min(a), hi.max(b))));
+        } else {
+            focus.extend(windows.iter().filter(|&&w| near_sensors.iter().any(|&s| box_gap(w, s) <= WINDOW_REACH)));
+        }
+        let margin = Vec3::splat(FOCUS_MARGIN);
+        Self { finest: size, focus: focus.into_iter().map(|(lo, hi)| (lo - margin, hi + margin)).collect() }
+    }
+
+    /// The same sizing for places within `region`: only the focus boxes
+    /// that can be the nearest to some point of it (a large model's
+    /// surfaces each test a few boxes, not all).
+    fn within(&self, region: Bounds) -> Self {
+        let reach = 0.5 * (region.1 - region.0).length();
+        let centre = 0.5 * (region.0 + region.1);
+        let farthest = self.focus.iter().map(|&b| point_gap(centre, b) + reach).fold(f32::INFINITY, f32::min);
+        Self { finest: self.finest, focus: self.focus.iter().copied().filter(|&b| box_gap(region, b) <= farthest).collect() }
     }
 
     /// The side allowed for a cell with `centre` and half-diagonal `reach`:
     /// set by the cell's nearest point to the focus.
     fn allowed(&self, centre: Vec3, reach: f32) -> f32 {
-        let Some((lo, hi)) = self.focus else { return self.finest };
-        let outside = (lo - centre).max(centre - hi).max(Vec3::ZERO).length();
-        let distance = (outside - reach).max(0.0);
-        (self.finest + GROWTH * distance).min(self.finest * COARSEST)
+        if self.focus.is_empty() {
+            return self.finest;
+        }
+        let mut outside = f32::INFINITY;
+        for &b in &self.focus {
+            outside = outside.min(point_gap(centre, b));
+            if outside <= reach {
+                return self.finest;
+            }
+        }
+        (self.finest + GROWTH * (outside - reach)).min(self.finest * COARSEST)
     }
+}
+
+/// The distance from `p` to the box `b` (0 inside it).
+fn point_gap(p: Vec3, (lo, hi): Bounds) -> f32 {
+    (lo - p).max(p - hi).max(Vec3::ZERO).length()
+}
+
+/// The distance between two boxes (0 when they meet).
+fn box_gap(a: Bounds, b: Bounds) -> f32 {
+    (b.0 - a.1).max(a.0 - b.1).max(Vec3::ZERO).length()
 }
 
 /// Splits a convex `polygon` by `planes` (at most 64), handing each part to
@@ -205,8 +266,9 @@ struct Cell {
 }
 
 /// A surface's plane and its quadtree's leaves.
-struct Quadtree<'a> {
-    sizing: &'a PatchSizing,
+struct Quadtree {
+    /// The sizing near the surface ([`PatchSizing::within`]).
+    sizing: PatchSizing,
     u: Vec3,
     v: Vec3,
     /// The plane's offset along its normal, and the normal.
@@ -217,9 +279,9 @@ struct Quadtree<'a> {
     root: Cell,
 }
 
-impl<'a> Quadtree<'a> {
+impl Quadtree {
     /// The quadtree of `surface` (made of `tris`), rooted at its corner.
-    fn for_surface(sizing: &'a PatchSizing, surface: &Surface, tris: &[Triangle]) -> Self {
+    fn for_surface(sizing: &PatchSizing, surface: &Surface, tris: &[Triangle]) -> Self {
         let (u, v) = plane_axes(surface.normal);
         let origin =
             tris.iter().flat_map(|t| t.vertices).fold((f32::INFINITY, f32::INFINITY), |(a, b), p| (a.min(p.dot(u)), b.min(p.dot(v))));
@@ -230,15 +292,13 @@ impl<'a> Quadtree<'a> {
             .fold(0, i64::max)
             + 1;
         let level = (extent.max(1) as u64).next_power_of_two().trailing_zeros();
-        Quadtree {
-            sizing,
-            u,
-            v,
-            offset: surface.normal.dot(tris[0].vertices[0]),
-            normal: surface.normal,
-            origin,
-            root: Cell { i: 0, j: 0, level },
-        }
+        let offset = surface.normal.dot(tris[0].vertices[0]);
+        // Every cell's centre lies in the root's square.
+        let side = (1u64 << level) as f32 * sizing.finest;
+        let corner = |a: f32, b: f32| u * (origin.0 + a) + v * (origin.1 + b) + surface.normal * offset;
+        let square = [corner(0.0, 0.0), corner(side, 0.0), corner(0.0, side), corner(side, side)];
+        let square = square.iter().fold((square[0], square[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        Quadtree { sizing: sizing.within(square), u, v, offset, normal: surface.normal, origin, root: Cell { i: 0, j: 0, level } }
     }
 
     /// The finest cell (i, j) holding `p`.
@@ -647,6 +707,50 @@ mod tests {
         }
         let total: f32 = mesh.patches.iter().map(|p| p.area).sum();
         assert!((total - 12.0).abs() < 1e-4);
+    }
+
+    /// Patches are finest around the sensors and the windows that light
+    /// them; a wing with windows but no sensor is coarse, unless the scene
+    /// has no sensor at all.
+    #[test]
+    fn patches_are_finest_where_the_sensors_are_and_coarse_in_a_wing_without_them() {
+        // A 64 m façade, a window at each end, a sensor 4 m inside from the first.
+        let tris = quad(64.0, 3.0);
+        let window = |x: f32| (Vec3::new(x, 0.0, 1.0), Vec3::new(x + 2.0, 0.0, 2.0));
+        let windows = [window(1.0), window(60.0)];
+        let sensor = Vec3::new(2.0, -4.0, 0.8);
+        let width_at = |sizing: &PatchSizing, x: f32| {
+            let mut surfaces = vec![surface_of(&tris)];
+            let large = LargeFaces::new(&tris, &surfaces, f32::INFINITY);
+            let mesh = subdivide(&tris, &mut surfaces, sizing, &[false], &[], &large);
+            let mut spans = mesh.patches.iter().map(|p| {
+                let pieces = &mesh.triangles[p.triangles.start as usize..p.triangles.end as usize];
+                pieces.iter().flatten().fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| (lo.min(v.x), hi.max(v.x)))
+            });
+            let (lo, hi) = spans.find(|&(lo, hi)| lo <= x && x <= hi).expect("a patch covers x");
+            hi - lo
+        };
+        let with_sensor = PatchSizing::around(0.5, &[sensor], &windows);
+        let two_rooms = PatchSizing::around(0.5, &[sensor, sensor + 38.0 * Vec3::X], &windows);
+        // The window 4 m from the sensor lights it: finest there (the
+        // sensor's own margin alone would allow 1 m).
+        assert!((width_at(&with_sensor, 2.2) - 0.5).abs() < 1e-4);
+        assert!(width_at(&with_sensor, 61.2) >= 4.0, "the far wing's window {}", width_at(&with_sensor, 61.2));
+        // Without sensors every window is the focus, and what lies between.
+        let without = PatchSizing::around(0.5, &[], &windows);
+        for x in [2.2, 30.2, 61.2] {
+            assert!((width_at(&without, x) - 0.5).abs() < 1e-4, "at x = {x}");
+        }
+        // The nearest focus box is found surface by surface from a few
+        // candidates: the same sizing as testing them all.
+        for x in [2.2, 9.7, 30.2, 61.2] {
+            let region = (Vec3::new(x - 1.0, 0.0, 0.0), Vec3::new(x + 1.0, 0.0, 3.0));
+            let near = two_rooms.within(region);
+            assert!(near.focus.len() < two_rooms.focus.len(), "at x = {x}");
+            for p in [region.0, region.1, Vec3::new(x, 0.0, 1.5)] {
+                assert_eq!(near.allowed(p, 0.3), two_rooms.allowed(p, 0.3), "at {p}");
+            }
+        }
     }
 
     /// A cell holding a quarter of its area of the surface or more stays a
