@@ -25,6 +25,7 @@ pub mod day;
 mod lanes;
 pub mod light;
 pub mod panel;
+mod parallel;
 pub mod radiance;
 pub mod report;
 pub mod scene;

@@ -415,7 +415,7 @@ impl SweptYear {
         model.set_panel_model(variation.material, Arc::new(WithoutLobes(panel.0.clone())));
         let path = SunPath::new(model, coefficients, &site, &up, None);
         let table = LobeTable::new(model, variation.material);
-        let hours = crate::light::par_map(None, HOURS, |k| {
+        let hours = crate::parallel::par_map(None, HOURS, |k| {
             let sun = suns[k]?;
             let rest = coefficients.sun_response(model, sun, &path, Some(1)).interreflected;
             Some((sun, table.sunlit(model, sun), rest))
@@ -436,7 +436,7 @@ impl SweptYear {
         sensors: &[usize],
     ) -> Result<(Vec<f64>, Option<f64>), String> {
         let beams: Vec<Option<Vec<SunBeam>>> =
-            crate::light::par_map(None, HOURS, |k| self.hours[k].as_ref().map(|(sun, ..)| model.sun_beams(&SunSource::unit(*sun))));
+            crate::parallel::par_map(None, HOURS, |k| self.hours[k].as_ref().map(|(sun, ..)| model.sun_beams(&SunSource::unit(*sun))));
         self.table.trace(model, coefficients, beams.iter().flatten().flatten(), None);
         let (hours, table) = (&self.hours, &self.table);
         let sun = |k: usize| {

@@ -53,7 +53,8 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use crate::light::coefficients::SunResponse;
-use crate::light::{HourSky, KnownSky, LightModel, SensorCoefficients, SkyBesidePanels, SunPath, TotalCoefficients, par_map};
+use crate::light::{HourSky, KnownSky, LightModel, SensorCoefficients, SkyBesidePanels, SunPath, TotalCoefficients};
+use crate::parallel::par_map;
 use crate::site::Site;
 use crate::sky::{Sky, SkyError, SkySpec, perez, sky_at};
 use crate::time::{Date, LocalDateTime, TimeOfDay};

@@ -21,6 +21,7 @@ use glam::{IVec3, Vec2, Vec3};
 use super::bounds;
 use super::cut_plane::{CutPlane, IN_PLANE};
 use super::{Surface, Triangle};
+use crate::parallel::par_map;
 
 /// A surface takes at most this many contact planes (the longest contacts).
 const MAX_CUTS: usize = 64;
@@ -138,39 +139,37 @@ fn same_plane((n, d): Plane, (m, e): Plane) -> bool {
 /// inside it, where its patches are cut.
 pub fn contact_cuts(large: &LargeFaces, surfaces: &[Surface]) -> Vec<Vec<CutPlane>> {
     let (triangles, grid) = (large.triangles, &large.grid);
-    surfaces
-        .iter()
-        .map(|surface| {
-            let own = surface.triangles.start as usize..surface.triangles.end as usize;
-            let tris = &triangles[own.clone()];
-            let (lo, hi) = bounds(tris);
-            let flat = Flat::new(surface.normal, tris);
-            let mut cuts: Vec<(CutPlane, f32)> = Vec::new();
-            for t in grid.near(lo - Vec3::splat(IN_PLANE), hi + Vec3::splat(IN_PLANE)) {
-                let face = &triangles[t as usize];
-                if own.contains(&(t as usize)) {
-                    continue;
-                }
-                let Some((p, q)) = flat.contact(face) else { continue };
-                let normal = face.normal();
-                let cut = CutPlane {
-                    normal,
-                    offset: normal.dot(face.vertices[0]),
-                    near: (p.min(q) - Vec3::splat(CONTACT_REACH), p.max(q) + Vec3::splat(CONTACT_REACH)),
-                };
-                let length = p.distance(q);
-                match cuts.iter_mut().find(|(c, _)| same_plane((c.normal, c.offset), (cut.normal, cut.offset))) {
-                    Some((c, total)) => {
-                        c.near = (c.near.0.min(cut.near.0), c.near.1.max(cut.near.1));
-                        *total += length;
-                    }
-                    None => cuts.push((cut, length)),
-                }
+    par_map(None, surfaces.len(), |index| {
+        let surface = &surfaces[index];
+        let own = surface.triangles.start as usize..surface.triangles.end as usize;
+        let tris = &triangles[own.clone()];
+        let (lo, hi) = bounds(tris);
+        let flat = Flat::new(surface.normal, tris);
+        let mut cuts: Vec<(CutPlane, f32)> = Vec::new();
+        for t in grid.near(lo - Vec3::splat(IN_PLANE), hi + Vec3::splat(IN_PLANE)) {
+            let face = &triangles[t as usize];
+            if own.contains(&(t as usize)) {
+                continue;
             }
-            cuts.sort_by(|a, b| b.1.total_cmp(&a.1));
-            cuts.into_iter().take(MAX_CUTS).map(|(c, _)| c).collect()
-        })
-        .collect()
+            let Some((p, q)) = flat.contact(face) else { continue };
+            let normal = face.normal();
+            let cut = CutPlane {
+                normal,
+                offset: normal.dot(face.vertices[0]),
+                near: (p.min(q) - Vec3::splat(CONTACT_REACH), p.max(q) + Vec3::splat(CONTACT_REACH)),
+            };
+            let length = p.distance(q);
+            match cuts.iter_mut().find(|(c, _)| same_plane((c.normal, c.offset), (cut.normal, cut.offset))) {
+                Some((c, total)) => {
+                    c.near = (c.near.0.min(cut.near.0), c.near.1.max(cut.near.1));
+                    *total += length;
+                }
+                None => cuts.push((cut, length)),
+            }
+        }
+        cuts.sort_by(|a, b| b.1.total_cmp(&a.1));
+        cuts.into_iter().take(MAX_CUTS).map(|(c, _)| c).collect()
+    })
 }
 
 /// A surface's plane and its triangles in the plane, to find where other

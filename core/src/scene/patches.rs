@@ -44,6 +44,7 @@ use glam::Vec3;
 use super::contacts::{LargeFaces, Plane, contact_cuts};
 use super::cut_plane::CutPlane;
 use super::{Surface, Triangle};
+use crate::parallel::par_map;
 
 /// One lighting patch.
 #[derive(Debug, Clone, PartialEq)]
@@ -473,7 +474,13 @@ pub fn subdivide(
     let mut mesh = PatchMesh::default();
     let contacts = contact_cuts(large, surfaces);
     let (cluster_of, members) = clusters(triangles, surfaces, sizing, clusterable, cuts, large);
-    for index in 0..surfaces.len() {
+    // Each surface's patches, surface by surface on every core.
+    let shared: &[Surface] = surfaces;
+    let surface_patches = par_map(None, shared.len(), |index| match cluster_of[index] {
+        Some(_) => Vec::new(),
+        None => patches_of_surface(&shared[index], triangles, sizing, cuts, &contacts[index]),
+    });
+    for (index, patches) in surface_patches.into_iter().enumerate() {
         let first_patch = mesh.patches.len() as u32;
         if let Some(cluster) = cluster_of[index] {
             let cluster = &members[cluster as usize];
@@ -485,56 +492,7 @@ pub fn subdivide(
             continue;
         }
         let surface = &mut surfaces[index];
-        let tris = &triangles[surface.triangles.start as usize..surface.triangles.end as usize];
-        let tree = Quadtree::for_surface(sizing, surface, tris);
-        let (u, v) = (tree.u, tree.v);
-        let cell_of = |p: Vec3| tree.cell_of(p);
-        let bounds = super::bounds(tris);
-        let planes: Vec<&CutPlane> = cuts.iter().filter(|c| c.cuts(tris, bounds)).chain(&contacts[index]).collect();
-        // Per leaf cell and side of the cutting planes: its pieces.
-        let mut cells: BTreeMap<CellKey, Pieces> = BTreeMap::new();
-        let mut add = |cell: Cell, polygon: Vec<Vec3>| {
-            split_by_planes(polygon, &planes, &mut |above, part| {
-                let pieces = cells.entry((cell.i, cell.j, above)).or_default();
-                for k in 1..part.len().saturating_sub(1) {
-                    let piece = [part[0], part[k], part[k + 1]];
-                    if 0.5 * (piece[1] - piece[0]).cross(piece[2] - piece[0]).length() > SLIVER_AREA {
-                        pieces.push(piece);
-                    }
-                }
-            })
-        };
-        let mut leaves = Vec::new();
-        for triangle in tris {
-            let [a, b, c] = triangle.vertices;
-            let longest = (b - a).length().max((c - b).length()).max((a - c).length());
-            let home = tree.leaf_at(cell_of(triangle.centroid()));
-            if longest <= tree.bounds(home).2 {
-                add(home, triangle.vertices.to_vec());
-                continue;
-            }
-            let (lo, hi) =
-                triangle.vertices.iter().map(|&p| cell_of(p)).fold(((i64::MAX, i64::MAX), (i64::MIN, i64::MIN)), |(lo, hi), (i, j)| {
-                    ((lo.0.min(i), lo.1.min(j)), (hi.0.max(i), hi.1.max(j)))
-                });
-            leaves.clear();
-            tree.leaves_over(tree.root, lo, hi, &mut leaves);
-            leaves.sort_unstable();
-            for &leaf in &leaves {
-                let (u0, v0, side) = tree.bounds(leaf);
-                let mut polygon = triangle.vertices.to_vec();
-                for (axis, bound, keep_above) in [(u, u0, true), (u, u0 + side, false), (v, v0, true), (v, v0 + side, false)] {
-                    polygon = clip(&polygon, axis, bound, keep_above);
-                    if polygon.len() < 3 {
-                        break;
-                    }
-                }
-                if polygon.len() >= 3 {
-                    add(leaf, polygon);
-                }
-            }
-        }
-        for pieces in merge_small_cells(&tree, cells) {
+        for pieces in patches {
             let start = mesh.triangles.len() as u32;
             let mut area = 0.0;
             let mut moment = Vec3::ZERO;
@@ -556,6 +514,68 @@ pub fn subdivide(
         surface.patches = first_patch..mesh.patches.len() as u32;
     }
     mesh
+}
+
+/// One surface's patches, each a list of render triangles: its quadtree's
+/// leaf cells cut by the window planes `cuts` that reach it and by its
+/// `contacts`, the small cells joined to a neighbour ([`merge_small_cells`]).
+fn patches_of_surface(
+    surface: &Surface,
+    triangles: &[Triangle],
+    sizing: &PatchSizing,
+    cuts: &[CutPlane],
+    contacts: &[CutPlane],
+) -> Vec<Pieces> {
+    let tris = &triangles[surface.triangles.start as usize..surface.triangles.end as usize];
+    let tree = Quadtree::for_surface(sizing, surface, tris);
+    let (u, v) = (tree.u, tree.v);
+    let cell_of = |p: Vec3| tree.cell_of(p);
+    let bounds = super::bounds(tris);
+    let planes: Vec<&CutPlane> = cuts.iter().filter(|c| c.cuts(tris, bounds)).chain(contacts).collect();
+    // Per leaf cell and side of the cutting planes: its pieces.
+    let mut cells: BTreeMap<CellKey, Pieces> = BTreeMap::new();
+    let mut add = |cell: Cell, polygon: Vec<Vec3>| {
+        split_by_planes(polygon, &planes, &mut |above, part| {
+            let pieces = cells.entry((cell.i, cell.j, above)).or_default();
+            for k in 1..part.len().saturating_sub(1) {
+                let piece = [part[0], part[k], part[k + 1]];
+                if 0.5 * (piece[1] - piece[0]).cross(piece[2] - piece[0]).length() > SLIVER_AREA {
+                    pieces.push(piece);
+                }
+            }
+        })
+    };
+    let mut leaves = Vec::new();
+    for triangle in tris {
+        let [a, b, c] = triangle.vertices;
+        let longest = (b - a).length().max((c - b).length()).max((a - c).length());
+        let home = tree.leaf_at(cell_of(triangle.centroid()));
+        if longest <= tree.bounds(home).2 {
+            add(home, triangle.vertices.to_vec());
+            continue;
+        }
+        let (lo, hi) =
+            triangle.vertices.iter().map(|&p| cell_of(p)).fold(((i64::MAX, i64::MAX), (i64::MIN, i64::MIN)), |(lo, hi), (i, j)| {
+                ((lo.0.min(i), lo.1.min(j)), (hi.0.max(i), hi.1.max(j)))
+            });
+        leaves.clear();
+        tree.leaves_over(tree.root, lo, hi, &mut leaves);
+        leaves.sort_unstable();
+        for &leaf in &leaves {
+            let (u0, v0, side) = tree.bounds(leaf);
+            let mut polygon = triangle.vertices.to_vec();
+            for (axis, bound, keep_above) in [(u, u0, true), (u, u0 + side, false), (v, v0, true), (v, v0 + side, false)] {
+                polygon = clip(&polygon, axis, bound, keep_above);
+                if polygon.len() < 3 {
+                    break;
+                }
+            }
+            if polygon.len() >= 3 {
+                add(leaf, polygon);
+            }
+        }
+    }
+    merge_small_cells(&tree, cells)
 }
 
 /// A leaf cell's pieces of a surface on one side of each cutting plane: its
