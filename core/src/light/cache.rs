@@ -92,6 +92,8 @@ pub fn key(scene: &Scene, settings: &LightSettings) -> u64 {
     for triangle in &scene.patches.triangles {
         floats(&triangle.map(|v| v.to_array()).concat());
     }
+    // How many rays each patch traces follows the focus.
+    floats(&scene.patch_sizing.as_floats());
     for sensor in &scene.sensors {
         floats(&[sensor.position.to_array(), sensor.normal.to_array(), sensor.axes[0].to_array(), sensor.axes[1].to_array()].concat());
         floats(&[sensor.size.unwrap_or(-1.0)]);

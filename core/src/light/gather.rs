@@ -49,6 +49,10 @@ fn check_memory(scene: &Scene, settings: &LightSettings) -> Result<(), String> {
 /// Sensors closer than this to a surface behind them read as lifted this far.
 const SENSOR_LIFT: f64 = 0.01;
 
+/// Rays from each sensor that find the patch sides it sees
+/// ([`LightModel::seen_by_sensors`]).
+const SEEN_PROBE_RAYS: usize = 256;
+
 /// Where a receiver's hemisphere light comes from: the **daylight
 /// coefficients** (bins of the sky sphere, each through the window it was
 /// seen through, see [`SkyKey`]) and the **form factors** (patch sides),
@@ -269,8 +273,11 @@ impl LightModel {
         };
         let targets = model.window_targets();
         let dark = super::solids::dark_sides(&model.scene);
+        // What a sensor sees straight gets all its rays: its noise would show.
+        let seen = model.seen_by_sensors();
         model.side_gathers = par_map(model.settings.threads, patches.len() * 2, |side| {
-            let gather = if dark[side] { Gather::default() } else { model.gather_patch_side(side, &targets) };
+            let share = if seen[side] { 1.0 } else { model.scene.patch_sizing.ray_share(patches[side / 2].centroid) };
+            let gather = if dark[side] { Gather::default() } else { model.gather_patch_side(side, &targets, share) };
             tick();
             gather
         });
@@ -361,7 +368,7 @@ impl LightModel {
     /// The hemisphere rays keep the sky only where no aimed ray could have
     /// drawn its path (through a window not aimed at, or after glass
     /// turned it back), so every path to the sky is counted once.
-    fn gather_patch_side(&self, side: usize, targets: &[WindowTarget]) -> Gather {
+    fn gather_patch_side(&self, side: usize, targets: &[WindowTarget], share: f64) -> Gather {
         let patch_index = side / 2;
         let gathers = match self.surface_of_patch(patch_index as u32) {
             Surface::Diffuse(_) => true,
@@ -375,10 +382,12 @@ impl LightModel {
         let normal = patch.normal.as_dvec3() * if side % 2 == 1 { -1.0 } else { 1.0 };
         let triangles = self.patch_triangles(patch_index);
         let reach = f64::from(patch.area).sqrt() * std::f64::consts::SQRT_2;
-        let aimed = self.windows_to_aim_at(patch.centroid.as_dvec3(), reach, normal, self.settings.window_rays_per_patch, targets);
+        let rays = |full: usize| ((full as f64 * share).ceil() as usize).min(full);
+        let window_rays = rays(self.settings.window_rays_per_patch);
+        let aimed = self.windows_to_aim_at(patch.centroid.as_dvec3(), reach, normal, window_rays, targets);
         let aimed_window = |w: u32| aimed.iter().any(|a| targets[a.target].window == w);
         let mut rng = Rng::new(1, side as u64);
-        let hemisphere = self.settings.rays_per_patch;
+        let hemisphere = rays(self.settings.rays_per_patch);
         let directions = cosine_directions(normal, hemisphere, &mut rng);
         let (mut coefficients, mut hits) = (Vec::new(), Vec::new());
         // The sky straight through an aimed-at window is the aimed rays'.
@@ -387,7 +396,7 @@ impl LightModel {
             let point = sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET;
             self.follow(point, dir, 1.0, 0, Way::START, &not_aimed, &mut coefficients, &mut hits);
         }
-        let aiming = Aiming { normal, aimed: &aimed, targets, rays: self.settings.window_rays_per_patch, hemisphere };
+        let aiming = Aiming { normal, aimed: &aimed, targets, rays: window_rays, hemisphere };
         self.aim_at_windows(&aiming, &mut rng, Eyes::Spread { triangles: &triangles, lift: normal * SURFACE_OFFSET }, &mut coefficients);
         Gather::from_raw(coefficients, &hits, hemisphere)
     }
@@ -501,6 +510,30 @@ impl LightModel {
     pub(super) fn patch_triangles(&self, patch: usize) -> Vec<([DVec3; 3], f64)> {
         let range = self.scene.patches.patches[patch].triangles.clone();
         with_cumulative_areas(self.scene.patches.triangles[range.start as usize..range.end as usize].iter().copied())
+    }
+
+    /// Which patch sides some sensor sees, straight or through glass, by a
+    /// few rays from each ([`SEEN_PROBE_RAYS`]): the sides whose gathers
+    /// keep all their rays wherever they lie ([`PatchSizing::ray_share`]).
+    ///
+    /// [`PatchSizing::ray_share`]: crate::scene::PatchSizing::ray_share
+    fn seen_by_sensors(&self) -> Vec<bool> {
+        let hits = par_map(self.settings.threads, self.scene.sensors.len(), |i| {
+            let sensor = &self.scene.sensors[i];
+            let mut rng = Rng::new(3, i as u64);
+            let (mut coefficients, mut hits) = (Vec::new(), Vec::new());
+            for point in place_sensor(&self.tracer, sensor, 1) {
+                for dir in cosine_directions(sensor.normal.as_dvec3(), SEEN_PROBE_RAYS, &mut rng) {
+                    self.follow(point, dir, 1.0, 0, Way::START, &|_| false, &mut coefficients, &mut hits);
+                }
+            }
+            hits.into_iter().map(|h| h.side).collect::<Vec<u32>>()
+        });
+        let mut seen = vec![false; self.scene.patches.patches.len() * 2];
+        for side in hits.into_iter().flatten() {
+            seen[side as usize] = true;
+        }
+        seen
     }
 
     /// A sensor's gather, its sun points and where its rays land. As a

@@ -105,6 +105,9 @@ pub struct Scene {
     /// whole model's bounds when it has neither): views frame it rather
     /// than a site's ground.
     pub focus: (Vec3, Vec3),
+    /// The patch sizes allowed where the patches lie: how much each patch
+    /// matters to the readings ([`PatchSizing::ray_share`]).
+    pub patch_sizing: PatchSizing,
 }
 
 /// The files a scene was read from, as the user would name them.
@@ -392,6 +395,7 @@ fn build(
             shades,
             bounds,
             focus,
+            patch_sizing: sizing,
         },
         warnings,
     })

@@ -137,6 +137,10 @@ const SENSOR_CUBE: f32 = 2.0;
 /// one: the windows of a sensor's room.
 const WINDOW_REACH: f32 = 5.0;
 
+/// The fewest of a patch side's rays traced far from the focus, as a share
+/// ([`PatchSizing::ray_share`]).
+const MIN_RAY_SHARE: f64 = 0.25;
+
 /// An axis-aligned box: (min, max).
 type Bounds = (Vec3, Vec3);
 
@@ -194,6 +198,22 @@ impl PatchSizing {
         let centre = 0.5 * (region.0 + region.1);
         let farthest = self.focus.iter().map(|&b| point_gap(centre, b) + reach).fold(f32::INFINITY, f32::min);
         Self { finest: self.finest, focus: self.focus.iter().copied().filter(|&b| box_gap(region, b) <= farthest).collect() }
+    }
+
+    /// The numbers the sizing is made of (for cache keys): the finest side
+    /// and every focus box's corners.
+    pub fn as_floats(&self) -> Vec<f32> {
+        let corners = self.focus.iter().flat_map(|(lo, hi)| lo.to_array().into_iter().chain(hi.to_array()));
+        std::iter::once(self.finest).chain(corners).collect()
+    }
+
+    /// The share of a patch side's rays that a patch at `centroid` traces:
+    /// all in the focus, fewer where patches may be coarser (the finest
+    /// size over the size allowed there, at least [`MIN_RAY_SHARE`]). Light
+    /// far from every sensor reaches them only through bounces that
+    /// average many patches, so its noise averages out too.
+    pub fn ray_share(&self, centroid: Vec3) -> f64 {
+        f64::from(self.finest / self.allowed(centroid, 0.0)).max(MIN_RAY_SHARE)
     }
 
     /// The side allowed for a cell with `centre` and half-diagonal `reach`:
@@ -756,6 +776,11 @@ mod tests {
         // sensor's own margin alone would allow 1 m).
         assert!((width_at(&with_sensor, 2.2) - 0.5).abs() < 1e-4);
         assert!(width_at(&with_sensor, 61.2) >= 4.0, "the far wing's window {}", width_at(&with_sensor, 61.2));
+        // Patches far from the sensors trace fewer rays, never under the least share.
+        assert_eq!(with_sensor.ray_share(Vec3::new(2.2, 0.0, 1.5)), 1.0);
+        assert_eq!(with_sensor.ray_share(Vec3::new(61.2, 0.0, 1.5)), MIN_RAY_SHARE);
+        let between = with_sensor.ray_share(Vec3::new(9.7, 0.0, 1.5));
+        assert!(MIN_RAY_SHARE < between && between < 1.0, "{between}");
         // Without sensors every window is the focus, and what lies between.
         let without = PatchSizing::around(0.5, &[], &windows);
         for x in [2.2, 30.2, 61.2] {
