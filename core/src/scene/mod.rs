@@ -316,13 +316,15 @@ fn build(
             bounds(&triangles[range.start as usize..range.end as usize])
         })
         .collect();
-    let sensor_points: Vec<Vec3> = sensors.iter().map(|s| s.position).collect();
     // What views frame: the windows and the sensors.
-    let focus =
-        window_bounds.iter().copied().chain(sensor_points.iter().map(|&p| (p, p))).reduce(|(lo, hi), (a, b)| (lo.min(a), hi.max(b)));
+    let focus = window_bounds
+        .iter()
+        .copied()
+        .chain(sensors.iter().map(|s| (s.position, s.position)))
+        .reduce(|(lo, hi), (a, b)| (lo.min(a), hi.max(b)));
     // Patches are finest around the sensors and the windows that light them (see `patches`).
     let sizing = if parsed.adaptive_patches {
-        PatchSizing::around(parsed.patch_size, &sensor_points, &window_bounds)
+        PatchSizing::around(parsed.patch_size, &sensors, &window_bounds)
     } else {
         PatchSizing::uniform(parsed.patch_size)
     };

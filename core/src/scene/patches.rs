@@ -43,7 +43,7 @@ use glam::Vec3;
 
 use super::contacts::{LargeFaces, Plane, contact_cuts};
 use super::cut_plane::CutPlane;
-use super::{Surface, Triangle};
+use super::{Sensor, Surface, Triangle};
 use crate::parallel::par_map;
 
 /// One lighting patch.
@@ -148,8 +148,9 @@ type Bounds = (Vec3, Vec3);
 /// the distance from it.
 ///
 /// The focus is where the readings are made and the light they see comes
-/// in: boxes around the sensors (one per [`SENSOR_CUBE`] they occupy) and
-/// around each window within [`WINDOW_REACH`] of them. Light far from every
+/// in: boxes around the sensors (one per grid, one per [`SENSOR_CUBE`]
+/// other sensors occupy) and around each window within [`WINDOW_REACH`] of
+/// them. Light far from every
 /// sensor reaches them only after bounces that average it, so a wing or a
 /// storey without sensors is coarse: a building with one room of sensors
 /// does not pay for the rest of it. A scene without sensors focuses on
@@ -171,12 +172,18 @@ impl PatchSizing {
 
     /// Finest within [`FOCUS_MARGIN`] of the `sensors` and of the `windows`
     /// (their bounds) that light them, or of the box around every window
-    /// when there is no sensor; finest everywhere with neither.
-    pub fn around(size: f32, sensors: &[Vec3], windows: &[Bounds]) -> Self {
-        let mut cubes: BTreeMap<[i32; 3], Bounds> = BTreeMap::new();
-        for &p in sensors {
-            let cube = (p / SENSOR_CUBE).floor().as_ivec3().to_array();
-            let (lo, hi) = cubes.entry(cube).or_insert((p, p));
+    /// when there is no sensor; finest everywhere with neither. A grid's
+    /// points make one box (a grid is a rectangle), other sensors one per
+    /// [`SENSOR_CUBE`] they occupy.
+    pub fn around(size: f32, sensors: &[Sensor], windows: &[Bounds]) -> Self {
+        let mut cubes: BTreeMap<(Option<&str>, [i32; 3]), Bounds> = BTreeMap::new();
+        for sensor in sensors {
+            let p = sensor.position;
+            let key = match &sensor.grid {
+                Some(grid) => (Some(grid.as_str()), [0; 3]),
+                None => (None, (p / SENSOR_CUBE).floor().as_ivec3().to_array()),
+            };
+            let (lo, hi) = cubes.entry(key).or_insert((p, p));
             (*lo, *hi) = (lo.min(p), hi.max(p));
         }
         let near_sensors: Vec<Bounds> = cubes.into_values().collect();
@@ -192,12 +199,16 @@ impl PatchSizing {
 
     /// The same sizing for places within `region`: only the focus boxes
     /// that can be the nearest to some point of it (a large model's
-    /// surfaces each test a few boxes, not all).
+    /// surfaces each test a few boxes, not all), nearest first.
     fn within(&self, region: Bounds) -> Self {
         let reach = 0.5 * (region.1 - region.0).length();
         let centre = 0.5 * (region.0 + region.1);
         let farthest = self.focus.iter().map(|&b| point_gap(centre, b) + reach).fold(f32::INFINITY, f32::min);
-        Self { finest: self.finest, focus: self.focus.iter().copied().filter(|&b| box_gap(region, b) <= farthest).collect() }
+        let mut focus: Vec<(f32, Bounds)> =
+            self.focus.iter().filter(|&&b| box_gap(region, b) <= farthest).map(|&b| (point_gap(centre, b), b)).collect();
+        // Nearest first: a cell in the focus stops at the first box holding it.
+        focus.sort_by(|a, b| a.0.total_cmp(&b.0));
+        Self { finest: self.finest, focus: focus.into_iter().map(|(_, b)| b).collect() }
     }
 
     /// The numbers the sizing is made of (for cache keys): the finest side
@@ -770,8 +781,10 @@ mod tests {
             let (lo, hi) = spans.find(|&(lo, hi)| lo <= x && x <= hi).expect("a patch covers x");
             hi - lo
         };
-        let with_sensor = PatchSizing::around(0.5, &[sensor], &windows);
-        let two_rooms = PatchSizing::around(0.5, &[sensor, sensor + 38.0 * Vec3::X], &windows);
+        let point =
+            |position: Vec3| Sensor { name: String::new(), position, normal: Vec3::Z, size: None, axes: [Vec3::X, Vec3::Y], grid: None };
+        let with_sensor = PatchSizing::around(0.5, &[point(sensor)], &windows);
+        let two_rooms = PatchSizing::around(0.5, &[point(sensor), point(sensor + 38.0 * Vec3::X)], &windows);
         // The window 4 m from the sensor lights it: finest there (the
         // sensor's own margin alone would allow 1 m).
         assert!((width_at(&with_sensor, 2.2) - 0.5).abs() < 1e-4);
