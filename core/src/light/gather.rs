@@ -276,8 +276,11 @@ impl LightModel {
         // What a sensor sees straight gets all its rays: its noise would show.
         let seen = model.seen_by_sensors();
         model.side_gathers = par_map(model.settings.threads, patches.len() * 2, |side| {
-            let share = if seen[side] { 1.0 } else { model.scene.patch_sizing.ray_share(patches[side / 2].centroid) };
-            let gather = if dark[side] { Gather::default() } else { model.gather_patch_side(side, &targets, share) };
+            let gather = match (dark[side], seen[side]) {
+                (true, _) => Gather::default(),
+                (false, true) => model.gather_patch_side(side, &targets, 1.0),
+                (false, false) => model.gather_patch_side(side, &targets, model.scene.patch_sizing.ray_share(patches[side / 2].centroid)),
+            };
             tick();
             gather
         });

@@ -308,7 +308,6 @@ fn build(
     }
     let windows = surfaces::windows(&triangles, &surfaces, &materials);
     let sensors = sensors::sensors(&parsed)?;
-    // Patches are finest around the windows and the sensors (see `patches`).
     let window_bounds: Vec<(Vec3, Vec3)> = windows
         .iter()
         .map(|w| {

@@ -152,11 +152,11 @@ type Bounds = (Vec3, Vec3);
 /// The focus is where the readings are made and the light they see comes
 /// in: boxes around the sensors (one per grid, one per [`SENSOR_CUBE`]
 /// other sensors occupy) and around each window within [`WINDOW_REACH`] of
-/// them. Light far from every
-/// sensor reaches them only after bounces that average it, so a wing or a
-/// storey without sensors is coarse: a building with one room of sensors
-/// does not pay for the rest of it. A scene without sensors focuses on
-/// the box around all its windows (what the viewer shows lit).
+/// them. Light far from every sensor reaches them only after bounces that
+/// average it, so a wing or a storey without sensors is coarse: a building
+/// with one room of sensors does not pay for the rest of it. A scene
+/// without sensors focuses on the box around all its windows (what the
+/// viewer shows lit).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PatchSizing {
     /// `patch_size`: the side of the finest patches, m.
@@ -188,13 +188,13 @@ impl PatchSizing {
             let (lo, hi) = cubes.entry(key).or_insert((p, p));
             (*lo, *hi) = (lo.min(p), hi.max(p));
         }
-        let near_sensors: Vec<Bounds> = cubes.into_values().collect();
-        let mut focus = near_sensors.clone();
-        if near_sensors.is_empty() {
-            focus.extend(windows.iter().copied().reduce(|(lo, hi), (a, b)| (lo.min(a), hi.max(b))));
+        let mut focus: Vec<Bounds> = cubes.into_values().collect();
+        let lighting: Vec<Bounds> = if focus.is_empty() {
+            windows.iter().copied().reduce(|(lo, hi), (a, b)| (lo.min(a), hi.max(b))).into_iter().collect()
         } else {
-            focus.extend(windows.iter().filter(|&&w| near_sensors.iter().any(|&s| box_gap(w, s) <= WINDOW_REACH)));
-        }
+            windows.iter().copied().filter(|&w| focus.iter().any(|&s| box_gap(w, s) <= WINDOW_REACH)).collect()
+        };
+        focus.extend(lighting);
         let margin = Vec3::splat(FOCUS_MARGIN);
         Self { finest: size, focus: focus.into_iter().map(|(lo, hi)| (lo - margin, hi + margin)).collect() }
     }
