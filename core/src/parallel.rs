@@ -7,11 +7,7 @@
 /// blocks of indices as they finish the last, so uneven costs (sunrise and
 /// noon hours, patches in the open and in corners) keep every core busy.
 pub(crate) fn par_map<T: Send>(threads: Option<usize>, count: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
-    // Asked once: the standard library reads the cgroup files at every call,
-    // and hours of a year call this thousands of times.
-    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
-    let threads = threads.unwrap_or_else(|| *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get())));
-    let threads = threads.max(1).min(count.max(1));
+    let threads = thread_count(threads).min(count.max(1));
     if threads == 1 {
         return (0..count).map(f).collect();
     }
@@ -39,4 +35,25 @@ pub(crate) fn par_map<T: Send>(threads: Option<usize>, count: usize, f: impl Fn(
     });
     blocks.sort_unstable_by_key(|(start, _)| *start);
     blocks.into_iter().flat_map(|(_, values)| values).collect()
+}
+
+/// Runs `a` and `b` side by side where `threads` allows two (all cores
+/// when `None`), else one after the other.
+pub(crate) fn par_join<A: Send, B>(threads: Option<usize>, a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B) -> (A, B) {
+    if thread_count(threads) < 2 {
+        return (a(), b());
+    }
+    std::thread::scope(|scope| {
+        let a = scope.spawn(a);
+        let b = b();
+        (a.join().expect("worker thread panicked"), b)
+    })
+}
+
+/// The threads `threads` asks for: all cores when `None`, at least one.
+fn thread_count(threads: Option<usize>) -> usize {
+    // Asked once: the standard library reads the cgroup files at every call,
+    // and hours of a year call this thousands of times.
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    threads.unwrap_or_else(|| *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))).max(1)
 }

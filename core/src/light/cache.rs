@@ -19,6 +19,7 @@ use glam::DVec3;
 use super::gather::{Gather, SensorGeometry};
 use super::landings::Landings;
 use super::{LightModel, LightSettings};
+use crate::parallel::par_join;
 use crate::scene::{MaterialKind, Scene};
 use crate::sky::SkyPatches;
 
@@ -82,6 +83,11 @@ impl Fnv {
 /// which, the sensors' placement, and the settings that shape the result;
 /// not comments, names, reflectances, the site or the thread count.
 pub fn key(scene: &Scene, settings: &LightSettings) -> u64 {
+    key_with_dark_sides(scene, settings, &super::solids::dark_sides(scene))
+}
+
+/// [`key`] with the sides inside solids found already.
+fn key_with_dark_sides(scene: &Scene, settings: &LightSettings, dark: &[bool]) -> u64 {
     let mut hash = Fnv::new();
     hash.bytes(MAGIC).u64(u64::from(FORMAT)).bytes(env!("CARGO_PKG_VERSION").as_bytes());
     let mut floats = |values: &[f32]| {
@@ -117,7 +123,7 @@ pub fn key(scene: &Scene, settings: &LightSettings) -> u64 {
     }
     // The sides left dark inside solids (which shells close depends on the
     // file's vertices as well as on the points).
-    for (side, _) in super::solids::dark_sides(scene).iter().enumerate().filter(|(_, dark)| **dark) {
+    for (side, _) in dark.iter().enumerate().filter(|(_, dark)| **dark) {
         hash.u64(side as u64);
     }
     hash.u64(settings.rays_per_patch as u64)
@@ -125,6 +131,7 @@ pub fn key(scene: &Scene, settings: &LightSettings) -> u64 {
         .u64(settings.rays_per_sensor as u64)
         .u64(settings.sky_rays_per_sensor as u64)
         .u64(settings.window_rays_per_sensor as u64)
+        .u64(settings.unseen_ray_share.to_bits())
         .u64(settings.sun_samples_per_patch as u64)
         .u64(settings.area_sensor_sun_grid as u64)
         .u64(u64::from(settings.sky_subdivision))
@@ -141,13 +148,31 @@ pub fn precompute_cached(
     progress: &(dyn Fn(f64) + Sync),
 ) -> Result<(LightModel, CacheOutcome), String> {
     settings.check()?;
-    let key = key(&scene, &settings);
+    // Every start needs the model (its shadow tracer, windows, openings)
+    // and the key, so they are made side by side; the sides inside solids
+    // the key holds are those a gather skips, found once.
+    let (empty, (key, dark)) = par_join(
+        settings.threads,
+        || LightModel::empty(scene.clone(), settings),
+        || {
+            let dark = super::solids::dark_sides(&scene);
+            (key_with_dark_sides(&scene, &settings, &dark), dark)
+        },
+    );
+    let empty = std::cell::Cell::new(Some(empty));
+    let take = || empty.take().expect("the model is loaded or gathered, once");
     let (model, outcome) = through_cache(
         dir,
         &format!("{key:016x}"),
         key,
-        |payload| LightModel::from_payload(scene.clone(), settings, payload),
-        || LightModel::precompute_with_progress(scene.clone(), settings, progress),
+        |payload| {
+            let (side_gathers, sensors) = LightModel::read_payload(&scene, &settings, payload)?;
+            Some(LightModel { side_gathers, sensors, ..take() })
+        },
+        || {
+            super::gather::check_memory(&scene, &settings)?;
+            Ok(take().gathered(&dark, progress))
+        },
         LightModel::payload,
     )?;
     model.cache_key.get_or_init(|| key);
@@ -647,8 +672,9 @@ impl LightModel {
         w.0
     }
 
-    /// The model from cached data; `None` when it does not fit the scene.
-    fn from_payload(scene: Arc<Scene>, settings: LightSettings, payload: &[u8]) -> Option<Self> {
+    /// The side gathers and sensor geometries a payload holds, if they fit
+    /// the scene.
+    fn read_payload(scene: &Scene, settings: &LightSettings, payload: &[u8]) -> Option<(Vec<Gather>, Vec<SensorGeometry>)> {
         let mut r = Reader(payload);
         let sides = r.u32()? as usize;
         if sides != scene.patches.patches.len() * 2 {
@@ -667,10 +693,7 @@ impl LightModel {
         if !r.is_empty() || !side_gathers.iter().all(fits) || !sensors.iter().all(|s| fits(&s.gather) && hits_fit(s)) {
             return None;
         }
-        let mut model = Self::empty(scene, settings);
-        model.side_gathers = side_gathers;
-        model.sensors = sensors;
-        Some(model)
+        Some((side_gathers, sensors))
     }
 }
 

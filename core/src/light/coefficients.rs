@@ -371,8 +371,7 @@ impl SensorCoefficients {
     /// The beams' interreflected light at every sensor, lux: traced on the
     /// sides some sensor sees and where the sensors' rays land.
     fn interreflected_sun(&self, model: &LightModel, beams: &[SunBeam], threads: Option<usize>) -> Vec<f64> {
-        let samples = model.settings.sun_samples_per_patch;
-        let sides_sun = model.sun_on_sides(beams, &|side| if self.seen[side] { samples } else { 0 }, threads);
+        let sides_sun = model.sun_on_sides(beams, &|side| if self.seen[side] { model.sun_samples(side) } else { 0 }, threads);
         let mut lux = self.first_bounce(model, beams, &sides_sun.reach, threads);
         add_products(&mut lux, self.later_bounces(&sides_sun.irradiance));
         lux

@@ -27,7 +27,7 @@ pub fn memory_budget_mib() -> u64 {
 /// Refuses, before any ray is traced, a precomputation whose gathers could
 /// outgrow the memory budget: at most 8 bytes per patch-side ray and 28 per
 /// sensor ray (a share, and where the ray landed).
-fn check_memory(scene: &Scene, settings: &LightSettings) -> Result<(), String> {
+pub(super) fn check_memory(scene: &Scene, settings: &LightSettings) -> Result<(), String> {
     let sides = 2.0 * scene.patches.patches.len() as f64 * settings.rays_per_patch as f64 * 8.0;
     // Only the first `rays_per_sensor` rays' landings are kept; the rest of a
     // sensor's sky rays live while it gathers.
@@ -261,7 +261,15 @@ impl LightModel {
     pub fn precompute_with_progress(scene: Arc<Scene>, settings: LightSettings, progress: &(dyn Fn(f64) + Sync)) -> Result<Self, String> {
         settings.check()?;
         check_memory(&scene, &settings)?;
-        let mut model = Self::empty(scene, settings);
+        let dark = super::solids::dark_sides(&scene);
+        Ok(Self::empty(scene, settings).gathered(&dark, progress))
+    }
+
+    /// This model, made by [`Self::empty`], with every patch side's and
+    /// sensor's gather; the sides `dark` inside solids ([`super::solids`])
+    /// gather nothing.
+    pub(super) fn gathered(mut self, dark: &[bool], progress: &(dyn Fn(f64) + Sync)) -> Self {
+        let model = &mut self;
         let patches = &model.scene.patches.patches;
         let total = patches.len() * 2 + model.scene.sensors.len();
         let done = std::sync::atomic::AtomicUsize::new(0);
@@ -272,14 +280,14 @@ impl LightModel {
             }
         };
         let targets = model.window_targets();
-        let dark = super::solids::dark_sides(&model.scene);
         // What a sensor sees straight gets all its rays: its noise would show.
         let seen = model.seen_by_sensors();
+        let unseen_share = if model.scene.sensors.is_empty() { 1.0 } else { model.settings.unseen_ray_share };
         model.side_gathers = par_map(model.settings.threads, patches.len() * 2, |side| {
             let gather = match (dark[side], seen[side]) {
                 (true, _) => Gather::default(),
                 (false, true) => model.gather_patch_side(side, &targets, 1.0),
-                (false, false) => model.gather_patch_side(side, &targets, model.scene.patch_sizing.ray_share(patches[side / 2].centroid)),
+                (false, false) => model.gather_patch_side(side, &targets, model.ray_shares[side / 2].min(unseen_share)),
             };
             tick();
             gather
@@ -290,7 +298,7 @@ impl LightModel {
             tick();
             geometry
         });
-        Ok(model)
+        self
     }
 
     /// Follows a ray through glass, adding the sky bin it leaves by to
@@ -309,7 +317,7 @@ impl LightModel {
         hits: &mut Vec<SideHit>,
     ) {
         let Way { window, reflected } = way;
-        match self.tracer.closest(origin, dir, 1e-6) {
+        match self.tracer().closest(origin, dir, 1e-6) {
             None if keep_sky(way) => {
                 coefficients.push((SkyKey { window, bin: self.sky_bins.sphere_bin(dir) as u32 }.pack(self.bin_count()), weight))
             }
@@ -525,7 +533,7 @@ impl LightModel {
             let sensor = &self.scene.sensors[i];
             let mut rng = Rng::new(3, i as u64);
             let (mut coefficients, mut hits) = (Vec::new(), Vec::new());
-            for point in place_sensor(&self.tracer, sensor, 1) {
+            for point in place_sensor(self.tracer(), sensor, 1) {
                 for dir in cosine_directions(sensor.normal.as_dvec3(), SEEN_PROBE_RAYS, &mut rng) {
                     self.follow(point, dir, 1.0, 0, Way::START, &|_| false, &mut coefficients, &mut hits);
                 }
@@ -545,9 +553,9 @@ impl LightModel {
     /// from its hemisphere rays.
     fn sensor_geometry(&self, index: usize, sensor: &Sensor, targets: &[WindowTarget]) -> SensorGeometry {
         let normal = sensor.normal.as_dvec3();
-        let points = place_sensor(&self.tracer, sensor, 4);
+        let points = place_sensor(self.tracer(), sensor, 4);
         let sun_points = match sensor.size {
-            Some(_) => place_sensor(&self.tracer, sensor, self.settings.area_sensor_sun_grid),
+            Some(_) => place_sensor(self.tracer(), sensor, self.settings.area_sensor_sun_grid),
             None => points.clone(),
         };
         let centre = points.iter().sum::<DVec3>() / points.len() as f64;

@@ -99,7 +99,11 @@ pub struct LightModel {
     pub settings: LightSettings,
     /// The sky and ground bins daylight coefficients refer to.
     pub sky_bins: SkyPatches,
-    tracer: Tracer,
+    /// The patches' render triangles, hits naming their patch: built on
+    /// first use, since a start from the cache traces none (a warm
+    /// `sensors` run on AC20-Institute-Var-2 with one office's sensors
+    /// spares 210 ms).
+    tracer: std::sync::OnceLock<Tracer>,
     /// The model's own triangles, hits naming their scene surface: fewer
     /// than the patches' render triangles, for shadow rays toward the sun.
     shadow_tracer: Tracer,
@@ -120,6 +124,9 @@ pub struct LightModel {
     openings: openings::Openings,
     /// Per patch, the box its sensors' landings are stored in.
     patch_boxes: Vec<landings::PatchBox>,
+    /// Per patch, the share of its sides' rays and sun samples by where it
+    /// lies ([`crate::scene::PatchSizing::ray_share`]).
+    ray_shares: Vec<f64>,
     /// Per patch side (2 per patch; empty for glass, the outer side of
     /// panels and sides inside solids, `solids`).
     side_gathers: Vec<Gather>,
@@ -203,7 +210,10 @@ impl LightModel {
     /// for ray queries ([`Self::trace`], [`Self::sun_irradiance`]), not for
     /// lighting.
     pub fn unlit(scene: Arc<Scene>) -> Self {
-        Self::empty(scene, LightSettings::default())
+        let model = Self::empty(scene, LightSettings::default());
+        // Built now: ray queries (a click in the viewer) should not wait.
+        model.tracer();
+        model
     }
 
     /// [`cache::key`] of the model's scene and settings.
@@ -213,12 +223,15 @@ impl LightModel {
 
     /// The first patch a ray meets and its distance.
     pub fn trace(&self, origin: DVec3, direction: DVec3) -> Option<(u32, f64)> {
-        self.tracer.closest(origin, direction, 1e-6).map(|hit| (hit.patch, hit.distance))
+        self.tracer().closest(origin, direction, 1e-6).map(|hit| (hit.patch, hit.distance))
+    }
+
+    fn tracer(&self) -> &Tracer {
+        self.tracer.get_or_init(|| Tracer::new(&self.scene.patches))
     }
 
     /// The model with its tracer and materials but nothing gathered yet.
     fn empty(scene: Arc<Scene>, settings: LightSettings) -> Self {
-        let tracer = Tracer::new(&scene.patches);
         let shadow_tracer = Tracer::over(
             &scene.triangles.iter().map(|t| t.vertices).collect::<Vec<_>>(),
             scene.surfaces.iter().enumerate().flat_map(|(k, s)| std::iter::repeat_n(k as u32, s.triangles.len())).collect(),
@@ -233,7 +246,7 @@ impl LightModel {
                 MaterialKind::Panel { .. } => Surface::Panel(u32::MAX),
             })
             .collect();
-        let windows = WindowGroups::new(&scene, &tracer);
+        let windows = WindowGroups::new(&scene, &shadow_tracer);
         let (panel_groups, group_of_surface) = panels::panel_groups(&scene, &windows);
         let mut panel_windows = vec![Vec::new(); panel_groups.len()];
         for window in &scene.windows {
@@ -254,9 +267,12 @@ impl LightModel {
             .iter()
             .map(|patch| landings::PatchBox::around(&scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize]))
             .collect();
+        let patches = &scene.patches.patches;
+        let ray_shares = par_map(settings.threads, patches.len(), |p| scene.patch_sizing.ray_share(patches[p].centroid));
         let mut model = Self {
             sky_bins: SkyPatches::reinhart(settings.sky_subdivision),
             patch_boxes,
+            ray_shares,
             windows,
             window_of_surface,
             panel_groups,
@@ -266,7 +282,7 @@ impl LightModel {
             openings,
             scene,
             settings,
-            tracer,
+            tracer: std::sync::OnceLock::new(),
             shadow_tracer,
             surfaces,
             side_gathers: Vec::new(),
@@ -403,16 +419,16 @@ impl LightModel {
     /// reaches them; the caller warns.
     pub fn sensors_inside_solids(&self) -> Vec<usize> {
         const RAYS: usize = 64;
-        let patches = &self.scene.patches.patches;
+        let surfaces = &self.scene.surfaces;
         (0..self.scene.sensors.len())
             .filter(|&i| {
                 let position = self.scene.sensors[i].position.as_dvec3();
                 let mut rng = Rng::new(4, i as u64);
                 let up = cosine_directions(DVec3::Z, RAYS / 2, &mut rng);
                 up.iter().chain(cosine_directions(DVec3::NEG_Z, RAYS / 2, &mut rng).iter()).all(|&d| {
-                    self.tracer
+                    self.shadow_tracer
                         .closest(position, d, 1e-6)
-                        .is_some_and(|hit| hit.distance < 5.0 && d.dot(patches[hit.patch as usize].normal.as_dvec3()) > 0.0)
+                        .is_some_and(|hit| hit.distance < 5.0 && d.dot(surfaces[hit.patch as usize].normal.as_dvec3()) > 0.0)
                 })
             })
             .collect()
