@@ -170,8 +170,9 @@ fn precompute_task(
     cache_dir: &LightCacheDir,
 ) -> Task<Result<LightModel, String>> {
     let dir = cache_dir.0.clone();
+    // The viewer meters exposure by tracing the model in a frame.
     AsyncComputeTaskPool::get()
-        .spawn(async move { cache::precompute_cached(scene, settings, dir.as_deref(), &|_| {}).map(|(model, _)| model) })
+        .spawn(async move { cache::precompute_cached(scene, settings, dir.as_deref(), &|_| {}).map(|(model, _)| model.with_tracer()) })
 }
 
 fn finish_precompute(mut engine: ResMut<LightEngine>, mut failed: MessageWriter<LightingFailed>) {

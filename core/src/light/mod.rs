@@ -210,10 +210,15 @@ impl LightModel {
     /// for ray queries ([`Self::trace`], [`Self::sun_irradiance`]), not for
     /// lighting.
     pub fn unlit(scene: Arc<Scene>) -> Self {
-        let model = Self::empty(scene, LightSettings::default());
-        // Built now: ray queries (a click in the viewer) should not wait.
-        model.tracer();
-        model
+        Self::empty(scene, LightSettings::default()).with_tracer()
+    }
+
+    /// This model with its patch tracer built now, not at the first ray
+    /// query: for a model whose queries must not wait (the viewer's clicks
+    /// and exposure metering run in a frame).
+    pub fn with_tracer(self) -> Self {
+        self.tracer();
+        self
     }
 
     /// [`cache::key`] of the model's scene and settings.
