@@ -81,6 +81,15 @@ fn outward_normal(tracer: &Tracer, window: &Window) -> (DVec3, bool) {
     (if along > against { normal } else { -normal }, along + against == 0)
 }
 
+/// An automatic view looks through the windows with a sensor within this
+/// distance (m, across) of one of them, where there are such: the
+/// sensors' room.
+const VIEW_SENSOR_REACH: f32 = 5.0;
+/// ... and this far (m) above or below its middle: the same storey.
+const VIEW_SENSOR_STOREY: f32 = 2.0;
+/// Surfaces this close (m) behind a window are its frame or sill, not the
+/// room's far wall, for an automatic view.
+const FRAME_DEPTH: f32 = 0.5;
 /// Eye height above the floor for an automatic view, m.
 const EYE_HEIGHT: f32 = 1.5;
 /// Windows of a group closer than this (m, centre to centre) light one
@@ -111,11 +120,12 @@ fn window_clusters(scene: &Scene, windows: &[u32]) -> Vec<Vec<u32>> {
 
 impl super::LightModel {
     /// A view from inside the room behind the largest cluster of vertical
-    /// windows (windows of one group within [`WINDOW_CLUSTER`] of each
+    /// windows, of those that light a sensor where some do (windows of one group within [`WINDOW_CLUSTER`] of each
     /// other: a group spans a whole façade, its middle may be a partition),
     /// looking out through them: the eye at eye height in the back corner
     /// (toward the far wall, then toward a side wall), looking at the
-    /// windows' middle a metre above the floor, so the floor's sun patches
+    /// window nearest the sensors where the cluster lights them all (else
+    /// nearest the cluster's middle) a metre above the floor, so the floor's sun patches
     /// and the windows are both in view. Where something stands between
     /// that corner and the windows (a stair, a column), the other back
     /// corner, then places nearer the windows, are tried for a clear sight. `None` without vertical windows
@@ -123,23 +133,49 @@ impl super::LightModel {
     pub fn interior_view(&self) -> Option<crate::scene::Viewpoint> {
         let scene = &self.scene;
         let area = |cluster: &[u32]| cluster.iter().map(|&w| scene.windows[w as usize].area).sum::<f32>();
+        // The room with sensors first: that is what the scene is about.
+        let lights = |window: glam::Vec3, sensor: glam::Vec3| {
+            (window - sensor).truncate().length() <= VIEW_SENSOR_REACH && (window.z - sensor.z).abs() <= VIEW_SENSOR_STOREY
+        };
+        let lights_sensors = |cluster: &[u32]| {
+            cluster.iter().any(|&w| {
+                let window = scene.windows[w as usize].centroid;
+                scene.sensors.iter().any(|s| lights(window, s.position))
+            })
+        };
         let cluster = self
             .windows
             .groups
             .iter()
             .filter(|g| g.outward.z.abs() < 0.7 && !g.enclosed)
             .flat_map(|g| window_clusters(scene, &g.windows).into_iter().map(move |c| (g, c)))
-            .max_by(|a, b| area(&a.1).total_cmp(&area(&b.1)));
+            .map(|(g, c)| ((lights_sensors(&c), area(&c)), g, c))
+            .max_by(|a, b| a.0.0.cmp(&b.0.0).then(a.0.1.total_cmp(&b.0.1)))
+            .map(|(_, g, c)| (g, c));
         let (group, cluster) = cluster?;
-        let centre = cluster.iter().map(|&w| scene.windows[w as usize].centroid * scene.windows[w as usize].area).sum::<glam::Vec3>()
+        let middle = cluster.iter().map(|&w| scene.windows[w as usize].centroid * scene.windows[w as usize].area).sum::<glam::Vec3>()
             / area(&cluster);
+        // The window nearest the sensors where these windows light them all
+        // (a study of one room), else nearest the cluster's middle: a long
+        // band of windows has a partition or a floor slab behind its
+        // middle, not a room.
+        let nearest = |to: glam::Vec3| move |a: &glam::Vec3, b: &glam::Vec3| a.distance(to).total_cmp(&b.distance(to));
+        let windows = || cluster.iter().map(|&w| scene.windows[w as usize].centroid);
+        let lit_by_cluster = |p: &glam::Vec3| windows().any(|w| lights(w, *p));
+        let one_room = !scene.sensors.is_empty() && scene.sensors.iter().map(|s| s.position).all(|p| lit_by_cluster(&p));
+        let sensor = scene.sensors.iter().map(|s| s.position).filter(|_| one_room).min_by(nearest(middle));
+        let centre = windows().min_by(nearest(sensor.unwrap_or(middle)))?;
         let inward = -glam::Vec3::new(group.outward.x as f32, group.outward.y as f32, 0.0).normalize();
         let across = inward.cross(glam::Vec3::Z);
         // How far a ray goes from `from` along `direction` before a surface (`fallback` if none).
         let reach = |from: glam::Vec3, direction: glam::Vec3, fallback: f32| {
             self.trace(from.as_dvec3(), direction.as_dvec3()).map_or(fallback, |(_, d)| d as f32)
         };
-        let depth = reach(centre + inward * 0.05, inward, 5.0);
+        // The room's depth, past the window's own frame and sill.
+        let mut depth = 0.05;
+        while depth < FRAME_DEPTH {
+            depth += 1e-3 + reach(centre + inward * depth, inward, 5.0);
+        }
         // The eye `back` of the room's depth in from the windows, toward the
         // side wall along `side`; and the target it looks at.
         let place = |back: f32, side: glam::Vec3| {
