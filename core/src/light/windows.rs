@@ -120,37 +120,39 @@ fn window_clusters(scene: &Scene, windows: &[u32]) -> Vec<Vec<u32>> {
 
 impl super::LightModel {
     /// A view from inside the room behind the largest cluster of vertical
-    /// windows, of those that light a sensor where some do (windows of one group within [`WINDOW_CLUSTER`] of each
+    /// windows (windows of one group within [`WINDOW_CLUSTER`] of each
     /// other: a group spans a whole façade, its middle may be a partition),
-    /// looking out through them: the eye at eye height in the back corner
-    /// (toward the far wall, then toward a side wall), looking at the
-    /// window nearest the sensors where the cluster lights them all (else
-    /// nearest the cluster's middle) a metre above the floor, so the floor's sun patches
-    /// and the windows are both in view. Where something stands between
-    /// that corner and the windows (a stair, a column), the other back
-    /// corner, then places nearer the windows, are tried for a clear sight. `None` without vertical windows
-    /// that see the sky.
+    /// of those that light a sensor where some do, looking out through
+    /// them: the eye at eye height in the back corner (toward the far wall,
+    /// then toward a side wall), looking a metre above the floor at the
+    /// window nearest the sensors where the cluster lights them all (a
+    /// study of one room), else nearest the cluster's middle, so the
+    /// floor's sun patches and the windows are both in view. Where
+    /// something stands between that corner and the windows (a stair, a
+    /// column), the other back corner, then places nearer the windows, are
+    /// tried for a clear sight. `None` without vertical windows that see
+    /// the sky.
     pub fn interior_view(&self) -> Option<crate::scene::Viewpoint> {
         let scene = &self.scene;
+        let centroids = |cluster: &[u32]| cluster.iter().map(|&w| scene.windows[w as usize].centroid).collect::<Vec<_>>();
         let area = |cluster: &[u32]| cluster.iter().map(|&w| scene.windows[w as usize].area).sum::<f32>();
+        // Whether a window of `windows` lights `sensor`: near it, on its storey.
+        let lit_by = |windows: &[glam::Vec3], sensor: glam::Vec3| {
+            windows.iter().any(|&w| (w - sensor).truncate().length() <= VIEW_SENSOR_REACH && (w.z - sensor.z).abs() <= VIEW_SENSOR_STOREY)
+        };
+        let sensors: Vec<glam::Vec3> = scene.sensors.iter().map(|s| s.position).collect();
         // The room with sensors first: that is what the scene is about.
-        let lights = |window: glam::Vec3, sensor: glam::Vec3| {
-            (window - sensor).truncate().length() <= VIEW_SENSOR_REACH && (window.z - sensor.z).abs() <= VIEW_SENSOR_STOREY
-        };
-        let lights_sensors = |cluster: &[u32]| {
-            cluster.iter().any(|&w| {
-                let window = scene.windows[w as usize].centroid;
-                scene.sensors.iter().any(|s| lights(window, s.position))
-            })
-        };
         let cluster = self
             .windows
             .groups
             .iter()
             .filter(|g| g.outward.z.abs() < 0.7 && !g.enclosed)
             .flat_map(|g| window_clusters(scene, &g.windows).into_iter().map(move |c| (g, c)))
-            .map(|(g, c)| ((lights_sensors(&c), area(&c)), g, c))
-            .max_by(|a, b| a.0.0.cmp(&b.0.0).then(a.0.1.total_cmp(&b.0.1)))
+            .map(|(g, c)| {
+                let windows = centroids(&c);
+                ((sensors.iter().any(|&s| lit_by(&windows, s)), area(&c)), g, c)
+            })
+            .max_by(|(a, ..), (b, ..)| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)))
             .map(|(_, g, c)| (g, c));
         let (group, cluster) = cluster?;
         let middle = cluster.iter().map(|&w| scene.windows[w as usize].centroid * scene.windows[w as usize].area).sum::<glam::Vec3>()
@@ -160,11 +162,10 @@ impl super::LightModel {
         // band of windows has a partition or a floor slab behind its
         // middle, not a room.
         let nearest = |to: glam::Vec3| move |a: &glam::Vec3, b: &glam::Vec3| a.distance(to).total_cmp(&b.distance(to));
-        let windows = || cluster.iter().map(|&w| scene.windows[w as usize].centroid);
-        let lit_by_cluster = |p: &glam::Vec3| windows().any(|w| lights(w, *p));
-        let one_room = !scene.sensors.is_empty() && scene.sensors.iter().map(|s| s.position).all(|p| lit_by_cluster(&p));
-        let sensor = scene.sensors.iter().map(|s| s.position).filter(|_| one_room).min_by(nearest(middle));
-        let centre = windows().min_by(nearest(sensor.unwrap_or(middle)))?;
+        let windows = centroids(&cluster);
+        let one_room = !sensors.is_empty() && sensors.iter().all(|&s| lit_by(&windows, s));
+        let sensor = sensors.iter().copied().filter(|_| one_room).min_by(nearest(middle));
+        let centre = windows.iter().copied().min_by(nearest(sensor.unwrap_or(middle)))?;
         let inward = -glam::Vec3::new(group.outward.x as f32, group.outward.y as f32, 0.0).normalize();
         let across = inward.cross(glam::Vec3::Z);
         // How far a ray goes from `from` along `direction` before a surface (`fallback` if none).
