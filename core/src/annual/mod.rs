@@ -408,15 +408,18 @@ const DAYS_PER_RUN: usize = 16;
 impl AnnualOptions<'_> {
     /// The hours of `weather`'s year whose sun the study reads (one per
     /// hour): lit, with direct normal irradiance, and occupied, or any such
-    /// hour when every hour is kept. The year's sun is traced for these
-    /// alone.
+    /// hour when every hour is kept. Without a light cache the year's sun
+    /// is traced for these alone; a table stored there holds every sunny
+    /// hour ([`SunHours`]).
     pub fn hours_with_sun(&self, weather: &Weather) -> Vec<bool> {
-        weather
-            .hours
-            .iter()
-            .map(|h| h.direct_normal > 0.0 && h.diffuse_horizontal > 0.0 && (self.hourly.is_some() || self.occupancy.contains(h.hour)))
-            .collect()
+        weather.hours.iter().map(|h| has_sun(h) && (self.hourly.is_some() || self.occupancy.contains(h.hour))).collect()
     }
+}
+
+/// Whether an hour of weather has sun a study may read: direct normal
+/// irradiance, and diffuse light (an hour without is dark).
+fn has_sun(hour: &crate::weather::WeatherHour) -> bool {
+    hour.direct_normal > 0.0 && hour.diffuse_horizontal > 0.0
 }
 
 /// Runs the year. With `options.shades`, every occupied hour lowers the
@@ -464,7 +467,12 @@ pub fn annual(
         (Some(table), _) if !table.holds(&with_sun) => return Err("the year's sun was traced for other hours than this study reads".into()),
         (Some(table), _) => YearSun::Table(table),
         (None, None) => match options.sun_cache.and_then(|dir| {
-            SunHours::cached(model, coefficients, site, shades.is_some(), &with_sun, dir, &|done| progress(SUN_TRACING_SHARE * done))
+            // A stored table serves the site's next studies too (`--hourly`,
+            // other occupied hours): every sunny hour, where that fits.
+            let sunny: Vec<bool> = weather.hours.iter().map(has_sun).collect();
+            let groups = if shades.is_some() { model.scene.shades.len() } else { 0 };
+            let stored = if SunHours::would_fit(model.scene.sensors.len(), groups, &sunny) { &sunny } else { &with_sun };
+            SunHours::cached(model, coefficients, site, shades.is_some(), stored, dir, &|done| progress(SUN_TRACING_SHARE * done))
         }) {
             Some((table, _)) => {
                 own_table = table;

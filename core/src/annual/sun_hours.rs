@@ -10,16 +10,18 @@
 //! EPW gives how strong the sun is, not where it is), and the light is
 //! linear in the sun's strength: so an hour of the year is a product with
 //! no ray traced, and a table serves every weather file of the site whose
-//! sunny hours it holds. Hours nobody reads are not traced: an overcast
-//! hour's sun, a night office's (a quarter of the sun-up hours of Chicago's
-//! year with the default occupancy). The table is stored in the light
-//! cache beside the scene's precomputation ([`SunHours::cached`]), keyed by
-//! what it depends on beyond it: every material's light (reflectances,
-//! glass, panel keys), the site, the shade groups. A study that reads
-//! hours the stored table lacks traces those hours alone and stores a
-//! table of both (the stored rows copied): an `--hourly` run after a plain
-//! one traces the unoccupied sunny hours, not the year again, and two
-//! weather files of one site settle on one table.
+//! sunny hours it holds. An overcast hour's sun is not traced. The table
+//! is stored in the light cache beside the scene's precomputation
+//! ([`SunHours::cached`]), keyed by what it depends on beyond it: every
+//! material's light (reflectances, glass, panel keys), the site, the shade
+//! groups. A study that stores a table traces every sunny hour, occupied
+//! or not, where the table fits, so that the next study of the site
+//! (`--hourly`, other occupied hours) reads it as it is: the unoccupied
+//! quarter of Chicago's sunny hours costs the office's cold year 0.5 s
+//! and spares its `--hourly` year after a plain one 1.1 s (2 cores). A
+//! study that reads hours the stored table lacks traces those hours alone
+//! and stores a table of both (the stored rows copied), so two weather
+//! files of one site settle on one table.
 
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -196,6 +198,12 @@ impl SunHours {
             }
         }
         Ok(())
+    }
+
+    /// Whether a table of `sensors` (and `shade_groups`) for `hours` would
+    /// fit in [`MAX_TABLE_BYTES`], counting every hour as sunny.
+    pub fn would_fit(sensors: usize, shade_groups: usize, hours: &[bool]) -> bool {
+        hours.iter().filter(|&&h| h).count() * row_bytes(sensors, shade_groups) <= MAX_TABLE_BYTES
     }
 
     /// How many rows the file holds.

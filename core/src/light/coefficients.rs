@@ -38,7 +38,7 @@ use glam::DVec3;
 
 use super::cache::{self, CacheOutcome, Fnv, Reader, Writer};
 use super::daylight::{KeyRadiance, RadianceSlots};
-use super::sun::Reach;
+use super::sun::SidesReach;
 use super::{LightModel, SensorReading, SunBeam, luminous, par_map};
 use crate::site::Site;
 use crate::sky::{LUMINOUS_EFFICACY, Sky, SunSource};
@@ -119,7 +119,7 @@ impl LightModel {
     }
 
     /// Which sides some sensor's rays land on.
-    fn sides_hit(&self) -> Vec<bool> {
+    pub(super) fn sides_hit(&self) -> Vec<bool> {
         let mut hit = vec![false; self.side_gathers.len()];
         for (side, _, _) in self.sensors.iter().flat_map(|sensor| sensor.landings.by_side()) {
             hit[side as usize] = true;
@@ -371,14 +371,15 @@ impl SensorCoefficients {
     /// The beams' interreflected light at every sensor, lux: traced on the
     /// sides some sensor sees and where the sensors' rays land.
     fn interreflected_sun(&self, model: &LightModel, beams: &[SunBeam], threads: Option<usize>) -> Vec<f64> {
-        let sides_sun = model.sun_on_sides(beams, &|side| if self.seen[side] { model.sun_samples(side) } else { 0 }, threads);
+        let sides_sun =
+            model.sun_on_sides(beams, &|side| if self.seen[side] { model.sun_samples(side) } else { 0 }, Some(&self.hit), threads);
         let mut lux = self.first_bounce(model, beams, &sides_sun.reach, threads);
         add_products(&mut lux, self.later_bounces(&sides_sun.irradiance));
         lux
     }
 
     /// The beams' first bounce where each sensor's rays land, lux.
-    pub(super) fn first_bounce(&self, model: &LightModel, beams: &[SunBeam], reach: &[Reach], threads: Option<usize>) -> Vec<f64> {
+    pub(super) fn first_bounce(&self, model: &LightModel, beams: &[SunBeam], reach: &SidesReach, threads: Option<usize>) -> Vec<f64> {
         par_map(threads, model.sensors.len(), |i| luminous(model.sensor_sun_bounce(i, beams, reach)) * LUMINOUS_EFFICACY)
     }
 
@@ -499,7 +500,10 @@ impl SunPath {
             let sun = SunSource::unit(direction);
             let beams = model.sun_beams(&sun);
             let mut lux = vec![0.0; model.sensors.len()];
-            add_products(&mut lux, coefficients.later_bounces(&model.sun_on_sides(&beams, &|side| samples[side], Some(1)).irradiance));
+            add_products(
+                &mut lux,
+                coefficients.later_bounces(&model.sun_on_sides(&beams, &|side| samples[side], None, Some(1)).irradiance),
+            );
             lux
         });
         path.nodes = needed.into_iter().zip(values).collect();

@@ -35,6 +35,14 @@ impl PatchBox {
         [axis(relative.x, self.step.x), axis(relative.y, self.step.y), axis(relative.z, self.step.z)]
     }
 
+    /// The box's corners, grown by the most a landing is lifted off its
+    /// patch ([`Self::point`]): every landing lies within.
+    pub(super) fn bounds(&self) -> (DVec3, DVec3) {
+        let lift = 0.5 * self.step.length();
+        let hi = self.lo + self.step * Self::STEPS;
+        ((self.lo - lift).as_dvec3(), (hi + lift).as_dvec3())
+    }
+
     /// A grid point, lifted off the patch's side along `normal` by as much as
     /// the grid may have moved it (half a step's diagonal) so it never falls
     /// behind the surface (a shadow ray from there would meet the patch).

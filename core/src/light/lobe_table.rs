@@ -126,7 +126,10 @@ impl LobeTable {
             let reach = model.sides_reach(&beams, Some(&coefficients.hit), Some(1));
             let first = coefficients.first_bounce(model, &beams, &reach, Some(1));
             let mut later = vec![0.0; model.sensors.len()];
-            add_products(&mut later, coefficients.later_bounces(&model.sun_on_sides(&beams, &|side| samples[side], Some(1)).irradiance));
+            add_products(
+                &mut later,
+                coefficients.later_bounces(&model.sun_on_sides(&beams, &|side| samples[side], None, Some(1)).irradiance),
+            );
             let per_plane = |values: Vec<f64>| values.iter().map(|&v| (v / cos) as f32).collect();
             NodeLight { first: per_plane(first), later: per_plane(later) }
         });

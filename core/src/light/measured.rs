@@ -28,6 +28,7 @@
 
 use glam::DVec3;
 
+use super::bvh::ParallelHits;
 use super::panels::SunBeam;
 use super::sampling::{Rng, point_on_triangle};
 use super::{LightModel, SURFACE_OFFSET, Surface};
@@ -132,8 +133,9 @@ impl LightModel {
                         if cos_sensor <= 0.0 || outgoing.z <= 0.0 {
                             continue;
                         }
-                        let glass =
-                            self.reaches_panel(origin, direction, group as u32).filter(|&(at, _)| at.distance(origin) > distance - 1e-3);
+                        let glass = self
+                            .reaches_panel(None, origin, direction, group as u32)
+                            .filter(|&(at, _)| at.distance(origin) > distance - 1e-3);
                         if let Some((_, transmittance)) = glass {
                             let weight = transmittance * cos_sensor * outgoing.z * share / (distance * distance);
                             let cell = data.outgoing_cell(outgoing).min(data.outgoing_cells().saturating_sub(1)) as u32;
@@ -151,15 +153,28 @@ impl LightModel {
     /// something else stops it first. The nearest of the group's window
     /// triangles along the ray, then one bounded traversal for what lies
     /// before it (a closest-hit search per pane cost most of a panel
-    /// room's year).
-    pub(super) fn reaches_panel(&self, origin: DVec3, direction: DVec3, group: u32) -> Option<(DVec3, f64)> {
-        let distance = (self.panel_windows[group as usize].iter())
-            .filter_map(|triangle| ray_meets_triangle(origin, direction, triangle))
-            .filter(|&t| t > 1e-6)
-            .min_by(f64::total_cmp)?;
+    /// room's year); among the ray's parallel hits alone when given
+    /// ([`super::sun::Shadows`]).
+    pub(super) fn reaches_panel(&self, among: Option<&ParallelHits>, origin: DVec3, direction: DVec3, group: u32) -> Option<(DVec3, f64)> {
+        let distance = match among {
+            Some(hits) => {
+                let mut nearest = None::<f64>;
+                hits.each_hit(origin, 1e-6, f64::INFINITY, |hit| {
+                    if self.group_of_surface[hit.patch as usize] == Some(group) {
+                        nearest = Some(nearest.map_or(hit.distance, |d| d.min(hit.distance)));
+                    }
+                    true
+                });
+                nearest?
+            }
+            None => (self.panel_windows[group as usize].iter())
+                .filter_map(|triangle| ray_meets_triangle(origin, direction, triangle))
+                .filter(|&t| t > 1e-6)
+                .min_by(f64::total_cmp)?,
+        };
         // What lies within a hair of the pane (its frame, a coplanar glass) does not stop the ray.
         let before = distance * (1.0 - 1e-6) - 1e-5;
-        let transmittance = self.through_glass(origin, direction, before, |kind| matches!(kind, Surface::Panel(g) if g == group))?;
+        let transmittance = self.through_glass(among, origin, direction, before, |kind| matches!(kind, Surface::Panel(g) if g == group))?;
         Some((origin + direction * distance, transmittance))
     }
 

@@ -6,6 +6,7 @@
 
 use glam::DVec3;
 
+use super::bvh::ParallelHits;
 use super::measured::MeasuredSun;
 use super::openings::WayIn;
 use super::panels::{self, SunBeam};
@@ -18,7 +19,27 @@ pub(super) struct SidesSun {
     /// Beam irradiance (W/m²) of each side, averaged over its sun samples.
     pub(super) irradiance: Vec<f64>,
     /// How beams may reach each side ([`super::openings`]).
-    pub(super) reach: Vec<Reach>,
+    pub(super) reach: SidesReach,
+}
+
+/// How beams may reach each patch side, with a dense mark of the sides
+/// they reach at all: each sensor's first bounce walks its landings' sides
+/// (hundreds an hour), and most are dark.
+pub(super) struct SidesReach {
+    reach: Vec<Reach>,
+    reached: Vec<bool>,
+}
+
+impl SidesReach {
+    fn new(reach: Vec<Reach>) -> Self {
+        let reached = reach.iter().map(|r| *r != Reach::None).collect();
+        Self { reach, reached }
+    }
+
+    /// How beams may reach `side`; `None` when not at all.
+    fn get(&self, side: usize) -> Option<&Reach> {
+        self.reached[side].then(|| &self.reach[side])
+    }
 }
 
 /// How the beams may reach a patch side.
@@ -27,23 +48,46 @@ pub(super) enum Reach {
     /// Not at all: facing away, or enclosed with no window toward a beam.
     None,
     /// From anywhere: the side sees the open sky.
-    Open,
+    Open(Shadows),
     /// Only by these windows.
-    Through(Vec<WayIn>),
+    Through(Vec<WayIn>, Shadows),
 }
+
+/// Per beam, the triangles its rays may meet on their way from anywhere on
+/// a side ([`Tracer::parallel_hits`]): a beam's rays from a side are
+/// parallel, so they test those alone instead of each traversing the BVH.
+/// `None` for a beam the side faces away from or whose rays may meet more
+/// than [`SHADOW_CANDIDATES`]; empty: none kept.
+///
+/// [`Tracer::parallel_hits`]: super::bvh::Tracer::parallel_hits
+pub(super) type Shadows = Box<[Option<ParallelHits>]>;
+
+/// Beam `b`'s parallel hits in `shadows`, where kept.
+fn beam_shadows(shadows: &Shadows, b: usize) -> Option<&ParallelHits> {
+    shadows.get(b).and_then(Option::as_ref)
+}
+
+/// The most triangles a beam's rays from a side test one by one (three
+/// dot products each, where a traversal of the BVH costs a ray about as
+/// much as fifty).
+const SHADOW_CANDIDATES: usize = 32;
 
 impl LightModel {
     /// The beams' irradiance at `point` of a side they `reach`: every beam
     /// on an open side; on an enclosed one only the beams whose ray may
     /// pass one of their windows (the others are blocked: not traced).
     fn reaching_irradiance(&self, reach: &Reach, point: DVec3, normal: DVec3, beams: &[SunBeam]) -> f64 {
+        let origin = point + normal * SURFACE_OFFSET;
         match reach {
             Reach::None => 0.0,
-            Reach::Open => self.beams_irradiance(point, normal, beams),
-            Reach::Through(ways) => {
-                let origin = point + normal * SURFACE_OFFSET;
-                self.openings.beams_reaching(point, ways).map(|b| self.beam_irradiance(origin, normal, &beams[b])).sum()
+            Reach::Open(shadows) => {
+                beams.iter().enumerate().map(|(b, beam)| self.beam_irradiance(origin, normal, beam, beam_shadows(shadows, b))).sum()
             }
+            Reach::Through(ways, shadows) => self
+                .openings
+                .beams_reaching(point, ways)
+                .map(|b| self.beam_irradiance(origin, normal, &beams[b], beam_shadows(shadows, b)))
+                .sum(),
         }
     }
 }
@@ -59,21 +103,29 @@ impl LightModel {
 
     /// How much of the sun reaches `point` (through glass; 0 when blocked).
     pub(super) fn sun_transmittance(&self, point: DVec3, sun: DVec3) -> f64 {
-        self.through_glass(point, sun, f64::INFINITY, |_| false).unwrap_or(0.0)
+        self.through_glass(None, point, sun, f64::INFINITY, |_| false).unwrap_or(0.0)
     }
 
     /// The product of the glass a ray crosses before `t_max`; `None` when
     /// anything else stops it first, but what `passes` lets through. The
     /// product does not depend on the order of the panes, so one traversal
-    /// visits them all and stops at the first stop.
-    pub(super) fn through_glass(&self, origin: DVec3, direction: DVec3, t_max: f64, passes: impl Fn(Surface) -> bool) -> Option<f64> {
+    /// visits them all and stops at the first stop; with the ray's parallel
+    /// hits (`among`, [`Shadows`]) it tests those alone.
+    pub(super) fn through_glass(
+        &self,
+        among: Option<&ParallelHits>,
+        origin: DVec3,
+        direction: DVec3,
+        t_max: f64,
+        passes: impl Fn(Surface) -> bool,
+    ) -> Option<f64> {
         let mut transmittance = Some(1.0);
         // Glass surfaces crossed, by distance: a ray through the edge between
         // two triangles of one surface meets it twice.
         // (A few at most: kept on the stack, shadow rays are many.)
         let mut crossed = [(u32::MAX, 0.0); 16];
         let mut count = 0;
-        self.shadow_tracer.each_hit(origin, direction, 1e-6, t_max, |hit| {
+        let visit = |hit: super::bvh::Hit| {
             let (surface, normal) = (hit.patch, self.scene.surfaces[hit.patch as usize].normal);
             match self.surface_kind(surface) {
                 Surface::Glass(glass) => {
@@ -91,16 +143,28 @@ impl LightModel {
                     false
                 }
             }
-        });
+        };
+        match among {
+            Some(hits) => hits.each_hit(origin, 1e-6, t_max, visit),
+            None => self.shadow_tracer.each_hit(origin, direction, 1e-6, t_max, visit),
+        }
         transmittance
     }
 
     /// How much of a panel lobe's light reaches `point` from `to_light`:
     /// the ray must leave through a window of the lobe's panel group (glass
     /// on the way counts), and from there the real sun (`window_sun`; `None`:
-    /// the windows taken as sunlit) must reach it.
-    fn lobe_transmittance(&self, point: DVec3, to_light: DVec3, group: u32, window_sun: Option<DVec3>) -> f64 {
-        self.reaches_panel(point, to_light, group).map_or(0.0, |(at, transmittance)| {
+    /// the windows taken as sunlit) must reach it. `among`: the lobe's
+    /// parallel hits from around `point`, when kept ([`Shadows`]).
+    fn lobe_transmittance(
+        &self,
+        point: DVec3,
+        to_light: DVec3,
+        group: u32,
+        window_sun: Option<DVec3>,
+        among: Option<&ParallelHits>,
+    ) -> f64 {
+        self.reaches_panel(among, point, to_light, group).map_or(0.0, |(at, transmittance)| {
             transmittance * window_sun.map_or(1.0, |sun| self.sun_transmittance(at + sun * SURFACE_OFFSET, sun))
         })
     }
@@ -126,8 +190,17 @@ impl LightModel {
 
     /// The beams on every diffuse patch side: shadow rays from `samples(side)`
     /// seeded points of each side (0: not traced) that faces a beam and
-    /// that a beam may reach (`threads` as [`par_map`]).
-    pub(super) fn sun_on_sides(&self, beams: &[SunBeam], samples: &(dyn Fn(usize) -> usize + Sync), threads: Option<usize>) -> SidesSun {
+    /// that a beam may reach (`threads` as [`par_map`]). The reach keeps
+    /// its [`Shadows`] on the sides `keep_shadows` names (where sensors'
+    /// rays land, for their first bounce) and drops the others': a
+    /// relight of a large model holds them for a few sides, not all.
+    pub(super) fn sun_on_sides(
+        &self,
+        beams: &[SunBeam],
+        samples: &(dyn Fn(usize) -> usize + Sync),
+        keep_shadows: Option<&[bool]>,
+        threads: Option<usize>,
+    ) -> SidesSun {
         let patches = &self.scene.patches.patches;
         let sides: Vec<(f64, Reach)> = par_map(threads, patches.len() * 2, |side| {
             let n = samples(side);
@@ -140,16 +213,22 @@ impl LightModel {
             let normal = self.side_normal(side as u32);
             let total: f64 =
                 (0..n).map(|_| sample_area(&triangles, &mut rng)).map(|point| self.reaching_irradiance(&reach, point, normal, beams)).sum();
+            let reach = match reach {
+                _ if keep_shadows.is_some_and(|keep| keep[side]) => reach,
+                Reach::Open(_) => Reach::Open(Shadows::default()),
+                Reach::Through(ways, _) => Reach::Through(ways, Shadows::default()),
+                Reach::None => Reach::None,
+            };
             (total / n as f64, reach)
         });
         let (irradiance, reach) = sides.into_iter().unzip();
-        SidesSun { irradiance, reach }
+        SidesSun { irradiance, reach: SidesReach::new(reach) }
     }
 
     /// How beams may reach every diffuse patch side (none but the sides
     /// `wanted`, when given), without tracing.
-    pub(super) fn sides_reach(&self, beams: &[SunBeam], wanted: Option<&[bool]>, threads: Option<usize>) -> Vec<Reach> {
-        par_map(threads, self.side_gathers.len(), |side| self.side_reach(side, beams, wanted))
+    pub(super) fn sides_reach(&self, beams: &[SunBeam], wanted: Option<&[bool]>, threads: Option<usize>) -> SidesReach {
+        SidesReach::new(par_map(threads, self.side_gathers.len(), |side| self.side_reach(side, beams, wanted)))
     }
 
     fn side_reach(&self, side: usize, beams: &[SunBeam], wanted: Option<&[bool]>) -> Reach {
@@ -160,13 +239,23 @@ impl LightModel {
         if !beams.iter().any(|b| normal.dot(b.to_light) > 0.0) {
             Reach::None
         } else if self.side_is_open(side) {
-            Reach::Open
+            Reach::Open(self.side_shadows(side, normal, beams))
         } else {
             match self.openings.ways_in(side / 2, beams) {
                 ways if ways.is_empty() => Reach::None,
-                ways => Reach::Through(ways),
+                ways => Reach::Through(ways, self.side_shadows(side, normal, beams)),
             }
         }
+    }
+
+    /// The triangles each beam's rays from `side` may meet ([`Shadows`]).
+    fn side_shadows(&self, side: usize, normal: DVec3, beams: &[SunBeam]) -> Shadows {
+        // Rays leave a side's points (its landings among them) lifted by the offset.
+        let (lo, hi) = self.patch_boxes[side / 2].bounds();
+        let (lo, hi) = (lo - DVec3::splat(SURFACE_OFFSET), hi + DVec3::splat(SURFACE_OFFSET));
+        let faced = |beam: &SunBeam| normal.dot(beam.to_light) > 0.0;
+        let shadows = |beam: &SunBeam| self.shadow_tracer.parallel_hits(lo, hi, beam.to_light, SHADOW_CANDIDATES);
+        beams.iter().map(|beam| if faced(beam) { shadows(beam) } else { None }).collect()
     }
 
     /// Sensor `index`'s direct sun (W/m², averaged over its sun points):
@@ -180,11 +269,11 @@ impl LightModel {
         let beams = &beams[..];
         let geometry = &self.sensors[index];
         let reach = if self.sees_open_sky(&geometry.gather) || beams.is_empty() {
-            Reach::Open
+            Reach::Open(Shadows::default())
         } else {
             let centre = geometry.sun_points.iter().sum::<DVec3>() / geometry.sun_points.len() as f64;
             let radius = geometry.sun_points.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
-            Reach::Through(self.openings.ways_into_sphere(centre, radius, beams))
+            Reach::Through(self.openings.ways_into_sphere(centre, radius, beams), Shadows::default())
         };
         let total: f64 = geometry.sun_points.iter().map(|&p| self.reaching_irradiance(&reach, p, geometry.normal, beams)).sum();
         total / geometry.sun_points.len() as f64 + through_data
@@ -193,14 +282,11 @@ impl LightModel {
     /// The first bounce of the beams off the sides sensor `index`'s rays
     /// meet (RGB W/m², evaluated where each ray lands), given how beams
     /// `reach` each side.
-    pub(super) fn sensor_sun_bounce(&self, index: usize, beams: &[SunBeam], reach: &[Reach]) -> [f64; 3] {
+    pub(super) fn sensor_sun_bounce(&self, index: usize, beams: &[SunBeam], reach: &SidesReach) -> [f64; 3] {
         let geometry = &self.sensors[index];
         let mut bounce = [0.0; 3];
         for (side, shares, points) in geometry.landings.by_side() {
-            let reach = &reach[side as usize];
-            if *reach == Reach::None {
-                continue;
-            }
+            let Some(reach) = reach.get(side as usize) else { continue };
             let Some(rho) = self.side_reflectance(side as usize) else { continue };
             let (normal, patch_box) = (self.side_normal(side), &self.patch_boxes[side as usize / 2]);
             for (&share, &grid) in shares.iter().zip(points) {
@@ -219,19 +305,19 @@ impl LightModel {
     /// Direct sun irradiance (W/m²) from all `beams` at `point` on a surface
     /// side with `normal`.
     pub fn beams_irradiance(&self, point: DVec3, normal: DVec3, beams: &[SunBeam]) -> f64 {
-        let origin = point + normal * SURFACE_OFFSET;
-        beams.iter().map(|beam| self.beam_irradiance(origin, normal, beam)).sum()
+        self.reaching_irradiance(&Reach::Open(Shadows::default()), point, normal, beams)
     }
 
-    /// One beam's irradiance at `origin` (already off its surface).
-    fn beam_irradiance(&self, origin: DVec3, normal: DVec3, beam: &SunBeam) -> f64 {
+    /// One beam's irradiance at `origin` (already off its surface); the
+    /// sun's own beam tests only the triangles `among` when given ([`Shadows`]).
+    fn beam_irradiance(&self, origin: DVec3, normal: DVec3, beam: &SunBeam, among: Option<&ParallelHits>) -> f64 {
         let cos = normal.dot(beam.to_light);
         if cos <= 0.0 {
             return 0.0;
         }
         let reach = match beam.panel_group {
-            None => self.sun_transmittance(origin, beam.to_light),
-            Some(group) => self.lobe_transmittance(origin, beam.to_light, group, beam.window_sun),
+            None => self.through_glass(among, origin, beam.to_light, f64::INFINITY, |_| false).unwrap_or(0.0),
+            Some(group) => self.lobe_transmittance(origin, beam.to_light, group, beam.window_sun, among),
         };
         beam.normal_irradiance * cos * reach
     }
@@ -249,7 +335,7 @@ impl LightModel {
         for &point in &geometry.sun_points {
             let origin = point + geometry.normal * SURFACE_OFFSET;
             for beam in beams.iter().filter(|b| !measured.covers(b.panel_group)) {
-                let e = self.beam_irradiance(origin, geometry.normal, beam);
+                let e = self.beam_irradiance(origin, geometry.normal, beam, None);
                 if e > 0.0 {
                     let hit = self.shadow_tracer.closest(origin, beam.to_light, 1e-6);
                     let window = hit.and_then(|h| self.window_of_surface[h.patch as usize]);
