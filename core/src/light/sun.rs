@@ -67,6 +67,13 @@ fn beam_shadows(shadows: &Shadows, b: usize) -> Option<&ParallelHits> {
     shadows.get(b).and_then(Option::as_ref)
 }
 
+/// The fewest sun samples for which a side finds its [`Shadows`] (where no
+/// sensor's rays land): the traversal costs about as much as a dozen rays,
+/// and the sun path gives sides few sensors care for 8 samples. On
+/// AC20-Institute-Var-2 with one office's sensors, finding them for every
+/// side made a year's sun path a third of the study.
+const SHADOWS_FROM_RAYS: usize = 16;
+
 /// The most triangles a beam's rays from a side test one by one (three
 /// dot products each, where a traversal of the BVH costs a ray about as
 /// much as fifty).
@@ -204,7 +211,8 @@ impl LightModel {
         let patches = &self.scene.patches.patches;
         let sides: Vec<(f64, Reach)> = par_map(threads, patches.len() * 2, |side| {
             let n = samples(side);
-            let reach = if n == 0 { Reach::None } else { self.side_reach(side, beams, None) };
+            let keep = keep_shadows.is_some_and(|keep| keep[side]);
+            let reach = if n == 0 { Reach::None } else { self.side_reach(side, beams, None, keep || n >= SHADOWS_FROM_RAYS) };
             if reach == Reach::None {
                 return (0.0, reach);
             }
@@ -214,7 +222,7 @@ impl LightModel {
             let total: f64 =
                 (0..n).map(|_| sample_area(&triangles, &mut rng)).map(|point| self.reaching_irradiance(&reach, point, normal, beams)).sum();
             let reach = match reach {
-                _ if keep_shadows.is_some_and(|keep| keep[side]) => reach,
+                _ if keep => reach,
                 Reach::Open(_) => Reach::Open(Shadows::default()),
                 Reach::Through(ways, _) => Reach::Through(ways, Shadows::default()),
                 Reach::None => Reach::None,
@@ -228,10 +236,11 @@ impl LightModel {
     /// How beams may reach every diffuse patch side (none but the sides
     /// `wanted`, when given), without tracing.
     pub(super) fn sides_reach(&self, beams: &[SunBeam], wanted: Option<&[bool]>, threads: Option<usize>) -> SidesReach {
-        SidesReach::new(par_map(threads, self.side_gathers.len(), |side| self.side_reach(side, beams, wanted)))
+        SidesReach::new(par_map(threads, self.side_gathers.len(), |side| self.side_reach(side, beams, wanted, true)))
     }
 
-    fn side_reach(&self, side: usize, beams: &[SunBeam], wanted: Option<&[bool]>) -> Reach {
+    /// How beams may reach `side`, with its [`Shadows`] when `shadows`.
+    fn side_reach(&self, side: usize, beams: &[SunBeam], wanted: Option<&[bool]>, shadows: bool) -> Reach {
         if beams.is_empty() || wanted.is_some_and(|w| !w[side]) || self.side_reflectance(side).is_none() {
             return Reach::None;
         }
@@ -239,17 +248,21 @@ impl LightModel {
         if !beams.iter().any(|b| normal.dot(b.to_light) > 0.0) {
             Reach::None
         } else if self.side_is_open(side) {
-            Reach::Open(self.side_shadows(side, normal, beams))
+            Reach::Open(self.side_shadows(side, normal, beams, shadows))
         } else {
             match self.openings.ways_in(side / 2, beams) {
                 ways if ways.is_empty() => Reach::None,
-                ways => Reach::Through(ways, self.side_shadows(side, normal, beams)),
+                ways => Reach::Through(ways, self.side_shadows(side, normal, beams, shadows)),
             }
         }
     }
 
-    /// The triangles each beam's rays from `side` may meet ([`Shadows`]).
-    fn side_shadows(&self, side: usize, normal: DVec3, beams: &[SunBeam]) -> Shadows {
+    /// The triangles each beam's rays from `side` may meet ([`Shadows`]);
+    /// none kept unless `wanted`.
+    fn side_shadows(&self, side: usize, normal: DVec3, beams: &[SunBeam], wanted: bool) -> Shadows {
+        if !wanted {
+            return Shadows::default();
+        }
         // Rays leave a side's points (its landings among them) lifted by the offset.
         let (lo, hi) = self.patch_boxes[side / 2].bounds();
         let (lo, hi) = (lo - DVec3::splat(SURFACE_OFFSET), hi + DVec3::splat(SURFACE_OFFSET));
