@@ -241,9 +241,11 @@ fn spawn_cameras(
         Projection::Perspective(PerspectiveProjection { fov: view.fov.to_radians(), ..default() }),
         Transform::from_translation(view.eye).looking_at(view.target, Vec3::Z),
     );
-    commands.spawn((picture_camera(), RenderTarget::Image(picture.clone().into()), placement.clone()));
+    // Both draw once what they show has arrived (`count_ready_frames`).
+    let waiting = |order| Camera { order, is_active: false, ..default() };
+    commands.spawn((picture_camera(), waiting(0), RenderTarget::Image(picture.clone().into()), placement.clone()));
     commands
-        .spawn((hybrid_camera(), Camera { order: 1, ..default() }, PhysicalUnits, RenderTarget::Image(physical.clone().into()), placement))
+        .spawn((hybrid_camera(), waiting(1), PhysicalUnits, RenderTarget::Image(physical.clone().into()), placement))
         .insert((Tonemapping::None, unit_exposure()));
     job.targets = Some([picture, physical]);
 }
@@ -275,8 +277,13 @@ fn watch_pipelines(cache: Res<PipelineCache>, failed: Res<PipelineFailed>) {
     }
 }
 
+/// Counts the frames drawn with what the mode shows, and draws none before
+/// it has arrived: frames queued behind a long precomputation fill a
+/// software rasterizer's memory (3 GB on lavapipe for
+/// AC20-Institute-Var-2) and take its cores from the light engine.
 fn count_ready_frames(
     mut job: ResMut<Job>,
+    mut cameras: Query<&mut Camera>,
     lighting: Option<Res<LightingState>>,
     sun_pass: Res<SunPassInput>,
     sun_sky: Option<Res<SunSky>>,
@@ -285,10 +292,10 @@ fn count_ready_frames(
     if failed.0.load(Ordering::Relaxed) {
         job.fail("a shader failed to build (its error is above): the picture would be wrong".into());
     }
-    if job.targets.is_some() && light_ready(job.request.settings.mode, lighting.as_deref(), &sun_pass, sun_sky.as_deref()) {
-        job.frames_drawn += 1;
-    } else {
-        job.frames_drawn = 0;
+    let ready = job.targets.is_some() && light_ready(job.request.settings.mode, lighting.as_deref(), &sun_pass, sun_sky.as_deref());
+    job.frames_drawn = if ready { job.frames_drawn + 1 } else { 0 };
+    for mut camera in cameras.iter_mut().filter(|camera| camera.is_active != ready) {
+        camera.is_active = ready;
     }
 }
 
