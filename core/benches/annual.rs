@@ -70,7 +70,7 @@ fn bench(c: &mut Criterion) {
         let folded = start.elapsed() - gathered;
         let sun_dir = cache.join("sun-only");
         let hours = AnnualOptions::default().hours_with_sun(&weather);
-        let sun_hours = SunHours::cached(&model, &coefficients, &scene.site, false, &hours, &sun_dir, &|_| {});
+        let sun_hours = SunHours::cached(&model, &coefficients, &scene.site, false, &hours, &hours, &sun_dir, &|_| {});
         let traced = start.elapsed() - gathered - folded;
         drop((coefficients, sun_hours));
         let _ = std::fs::remove_dir_all(&sun_dir);

@@ -721,7 +721,8 @@ fn the_years_sun_is_cached_and_a_warm_year_reads_what_a_traced_one_does() {
     let dir = std::env::temp_dir().join(format!("heliodon-sun-hours-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let cached = |model: &LightModel, site: &heliodon_core::site::Site| {
-        SunHours::cached(model, &coefficients, site, false, &[true; HOURS], &dir, &|_| {}).expect("a table of 19 sensors is kept")
+        SunHours::cached(model, &coefficients, site, false, &[true; HOURS], &[false; HOURS], &dir, &|_| {})
+            .expect("a table of 19 sensors is kept")
     };
     let (cold, outcome) = cached(&model, &site);
     assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");

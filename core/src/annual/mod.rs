@@ -451,7 +451,7 @@ pub fn annual(
             &own
         }
     };
-    let groups = if shades.is_some() { scene.shades.len() } else { 0 };
+    let groups = sun_hours::shade_groups(model, shades.is_some());
     if groups > 16 {
         return Err(format!("{} shade groups: at most 16 are studied together", groups));
     }
@@ -468,11 +468,10 @@ pub fn annual(
         (Some(table), _) => YearSun::Table(table),
         (None, None) => match options.sun_cache.and_then(|dir| {
             // A stored table serves the site's next studies too (`--hourly`,
-            // other occupied hours): every sunny hour, where that fits.
+            // other occupied hours): every sunny hour is worth keeping.
             let sunny: Vec<bool> = weather.hours.iter().map(has_sun).collect();
-            let groups = if shades.is_some() { model.scene.shades.len() } else { 0 };
-            let stored = if SunHours::would_fit(model.scene.sensors.len(), groups, &sunny) { &sunny } else { &with_sun };
-            SunHours::cached(model, coefficients, site, shades.is_some(), stored, dir, &|done| progress(SUN_TRACING_SHARE * done))
+            let progress = |done| progress(SUN_TRACING_SHARE * done);
+            SunHours::cached(model, coefficients, site, shades.is_some(), &with_sun, &sunny, dir, &progress)
         }) {
             Some((table, _)) => {
                 own_table = table;

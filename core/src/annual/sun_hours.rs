@@ -98,25 +98,33 @@ impl SunHours {
     /// group's direct sun) in the `hours` of the year a study reads, from
     /// the light cache in `dir`, traced and stored there first when it is
     /// not; `progress` hears the share of the hours traced (from any
-    /// thread). `None` when the table would take more than
-    /// [`MAX_TABLE_BYTES`] or cannot be stored: the year then traces its
-    /// sun hour by hour ([`YearSun::Traced`], the same numbers).
+    /// thread). A table traced anew holds the hours `worth_keeping` too
+    /// where it fits with them (every sunny hour, say, so that the site's
+    /// next study, `--hourly` or other occupied hours, reads it as it is).
+    /// `None` when the table would take more than [`MAX_TABLE_BYTES`] or
+    /// cannot be stored: the year then traces its sun hour by hour
+    /// ([`YearSun::Traced`], the same numbers).
+    #[allow(clippy::too_many_arguments)]
     pub fn cached(
         model: &LightModel,
         coefficients: &SensorCoefficients,
         site: &Site,
         shades: bool,
         hours: &[bool],
+        worth_keeping: &[bool],
         dir: &Path,
         progress: &(dyn Fn(f64) + Sync),
     ) -> Option<(Self, CacheOutcome)> {
-        let shade_groups = if shades { model.scene.shades.len() } else { 0 };
+        let shade_groups = shade_groups(model, shades);
         let row_bytes = row_bytes(model.scene.sensors.len(), shade_groups);
         let fits = |suns: &[Option<Option<DVec3>>]| suns.iter().flatten().flatten().count() * row_bytes <= MAX_TABLE_BYTES;
-        let ours = sun_directions(site, hours);
-        if !fits(&ours) {
+        let read = sun_directions(site, hours);
+        if !fits(&read) {
             return None;
         }
+        let keep: Vec<bool> = hours.iter().zip(worth_keeping).map(|(read, kept)| *read || *kept).collect();
+        let kept = sun_directions(site, &keep);
+        let (traced_hours, ours) = if fits(&kept) { (&keep[..], kept) } else { (hours, read) };
         let key = Self::key(model, site, shades);
         // A stored table lacking some of our hours: its rows are kept, ours added.
         let stored = std::cell::RefCell::new(None);
@@ -136,7 +144,7 @@ impl SunHours {
                 // Both tables' hours, unless the union would not fit: then ours alone.
                 let stored = stored.take().and_then(|table| {
                     let both: Vec<bool> =
-                        hours.iter().zip(&table.row_of_hour).map(|(ours, row)| *ours || *row != HourRow::NotTraced).collect();
+                        traced_hours.iter().zip(&table.row_of_hour).map(|(ours, row)| *ours || *row != HourRow::NotTraced).collect();
                     let suns = sun_directions(site, &both);
                     fits(&suns).then_some((table, suns))
                 });
@@ -200,12 +208,6 @@ impl SunHours {
         Ok(())
     }
 
-    /// Whether a table of `sensors` (and `shade_groups`) for `hours` would
-    /// fit in [`MAX_TABLE_BYTES`], counting every hour as sunny.
-    pub fn would_fit(sensors: usize, shade_groups: usize, hours: &[bool]) -> bool {
-        hours.iter().filter(|&&h| h).count() * row_bytes(sensors, shade_groups) <= MAX_TABLE_BYTES
-    }
-
     /// How many rows the file holds.
     fn rows(&self) -> usize {
         ((self.file.len() - ROWS_AT) / row_bytes(self.sensors, self.shade_groups) as u64) as usize
@@ -229,9 +231,8 @@ impl SunHours {
         let mut head = vec![0u8; ROWS_AT as usize];
         file.read_at(0, &mut head).ok()?;
         let words: Vec<u32> = head.chunks_exact(4).map(|b| u32::from_le_bytes(b.try_into().expect("4 bytes"))).collect();
-        let (sensors, shade_groups, row_count) = (words[0] as usize, words[1] as usize, words[2] as usize);
-        let expected_groups = if shades { model.scene.shades.len() } else { 0 };
-        if sensors != model.scene.sensors.len() || shade_groups != expected_groups || row_count > HOURS {
+        let (sensors, groups, row_count) = (words[0] as usize, words[1] as usize, words[2] as usize);
+        if sensors != model.scene.sensors.len() || groups != shade_groups(model, shades) || row_count > HOURS {
             return None;
         }
         let row_of_hour = words[3..]
@@ -243,10 +244,10 @@ impl SunHours {
                 _ => None,
             })
             .collect::<Option<Vec<_>>>()?;
-        (file.len() == ROWS_AT + (row_count * row_bytes(sensors, shade_groups)) as u64).then_some(Self {
+        (file.len() == ROWS_AT + (row_count * row_bytes(sensors, groups)) as u64).then_some(Self {
             key,
             sensors,
-            shade_groups,
+            shade_groups: groups,
             row_of_hour,
             file,
         })
@@ -320,6 +321,12 @@ impl SunHours {
     }
 }
 
+/// The shade groups whose direct sun a table keeps: every group of the
+/// model's scene when `shades` are studied, none otherwise.
+pub(super) fn shade_groups(model: &LightModel, shades: bool) -> usize {
+    if shades { model.scene.shades.len() } else { 0 }
+}
+
 /// Bytes of one hour's row: each sensor's direct and interreflected sun,
 /// then its direct sun through each of `shade_groups` groups' windows.
 fn row_bytes(sensors: usize, shade_groups: usize) -> usize {
@@ -356,7 +363,7 @@ impl<'a> YearSun<'a> {
     ) -> Self {
         let up: Vec<DVec3> = sun_directions(site, hours).into_iter().flatten().flatten().collect();
         let path = SunPath::new(model, coefficients, site, &up, None);
-        let shade_groups = if shades { model.scene.shades.len() } else { 0 };
+        let shade_groups = shade_groups(model, shades);
         YearSun::Traced { model, coefficients, site, path, hours: hours.to_vec(), shade_groups }
     }
 
@@ -465,9 +472,10 @@ mod tests {
         let (model, coefficients, site, dir) = test_room("unit");
         let every = [true; HOURS];
         let (written, outcome) =
-            SunHours::cached(&model, &coefficients, &site, false, &every, &dir, &|_| {}).expect("a small table is kept");
+            SunHours::cached(&model, &coefficients, &site, false, &every, &[false; HOURS], &dir, &|_| {}).expect("a small table is kept");
         assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");
-        let (read, outcome) = SunHours::cached(&model, &coefficients, &site, false, &every, &dir, &|_| {}).expect("a small table is kept");
+        let (read, outcome) =
+            SunHours::cached(&model, &coefficients, &site, false, &every, &[false; HOURS], &dir, &|_| {}).expect("a small table is kept");
         assert!(matches!(outcome, CacheOutcome::Hit(_)), "{outcome:?}");
         let traced = YearSun::traced(&model, &coefficients, &site, false, &every);
         let mut lit = 0;
@@ -485,20 +493,22 @@ mod tests {
     /// traces those alone and keeps the hours of both, with the same
     /// numbers as tables traced for each; an hour nobody asked for is an
     /// error, never a dark hour, from the table and from the year traced
-    /// hour by hour alike.
+    /// hour by hour alike. Hours worth keeping are traced with those read
+    /// where the table is new, so a later study of them reads it as it is.
     #[test]
     fn a_table_traced_for_some_hours_is_traced_again_for_more_and_keeps_both() {
         let (model, coefficients, site, dir) = test_room("union");
         let month = |m: u32| -> Vec<bool> { (0..HOURS).map(|k| calendar(k).0 == m).collect() };
         let (january, july) = (month(1), month(7));
         let traced_hours = AtomicUsize::new(0);
-        let cached = |hours: &[bool]| {
+        let cached_keeping = |hours: &[bool], worth_keeping: &[bool]| {
             traced_hours.store(0, Ordering::Relaxed);
             let count = |_| {
                 traced_hours.fetch_add(1, Ordering::Relaxed);
             };
-            SunHours::cached(&model, &coefficients, &site, false, hours, &dir, &count).expect("kept")
+            SunHours::cached(&model, &coefficients, &site, false, hours, worth_keeping, &dir, &count).expect("kept")
         };
+        let cached = |hours: &[bool]| cached_keeping(hours, &[false; HOURS]);
         let sun_up = |hours: &[bool]| (0..HOURS).filter(|&k| hours[k] && sun_direction(&site, k).is_some()).count();
         let (first, outcome) = cached(&january);
         assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");
@@ -524,6 +534,15 @@ mod tests {
         }
         let july_noon = both.response(noon_in(7)).unwrap().expect("the sun is up at a July noon");
         assert!(july_noon.direct.iter().chain(&july_noon.interreflected).any(|&e| e > 0.0));
+
+        let _ = std::fs::remove_dir_all(&dir);
+        let (kept, outcome) = cached_keeping(&january, &july);
+        assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");
+        assert!(kept.holds(&january) && kept.holds(&july));
+        assert_eq!(traced_hours.load(Ordering::Relaxed), sun_up(&january) + sun_up(&july));
+        let (_, outcome) = cached(&july);
+        assert!(matches!(outcome, CacheOutcome::Hit(_)), "the hours kept serve the next study: {outcome:?}");
+        assert_eq!(kept.response(noon_in(7)).unwrap(), both.response(noon_in(7)).unwrap());
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

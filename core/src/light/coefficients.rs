@@ -71,9 +71,6 @@ pub struct SensorCoefficients {
     /// Sides some sensor sees, directly or by interreflection: the sun
     /// elsewhere (on a roof, say) changes no reading and is not traced.
     seen: Vec<bool>,
-    /// Sides some sensor's rays land on: where the sun's first bounce is
-    /// traced, hour by hour.
-    pub(super) hit: Vec<bool>,
     /// Jacobi iterations of the slowest block.
     pub iterations: usize,
 }
@@ -115,16 +112,19 @@ impl LightModel {
                 }
             }
         }
-        SensorCoefficients { sensors, slots, sky, sun, seen, hit: self.sides_hit(), iterations }
+        SensorCoefficients { sensors, slots, sky, sun, seen, iterations }
     }
 
-    /// Which sides some sensor's rays land on.
-    pub(super) fn sides_hit(&self) -> Vec<bool> {
-        let mut hit = vec![false; self.side_gathers.len()];
-        for (side, _, _) in self.sensors.iter().flat_map(|sensor| sensor.landings.by_side()) {
-            hit[side as usize] = true;
-        }
-        hit
+    /// How many of the sensors' rays land on each side: where the sun's
+    /// first bounce is traced, hour by hour.
+    pub(super) fn landings_on_sides(&self) -> &[u32] {
+        self.landings_on_sides.get_or_init(|| {
+            let mut landed = vec![0; self.side_gathers.len()];
+            for (side, shares, _) in self.sensors.iter().flat_map(|sensor| sensor.landings.by_side()) {
+                landed[side as usize] += shares.len() as u32;
+            }
+            landed
+        })
     }
 
     /// [`Self::sensor_coefficients`] through the light cache in `dir`:
@@ -304,7 +304,7 @@ impl SensorCoefficients {
         };
         let (sky, sun) = (values(slots.len() * sensors)?, values(sides * sensors)?);
         let seen = (0..sides).map(|_| r.u32().map(|v| v != 0)).collect::<Option<Vec<_>>>()?;
-        r.is_empty().then(|| Self { sensors, slots, sky, sun, seen, hit: model.sides_hit(), iterations })
+        r.is_empty().then_some(Self { sensors, slots, sky, sun, seen, iterations })
     }
 
     /// Every sensor's reading under `sky` (`threads` as [`par_map`]): equal
@@ -344,7 +344,7 @@ impl SensorCoefficients {
     /// the later bounces from `path`.
     pub fn sun_response(&self, model: &LightModel, direction: DVec3, path: &SunPath, threads: Option<usize>) -> SunResponse {
         let beams = model.sun_beams(&SunSource::unit(direction));
-        let reach = model.sides_reach(&beams, Some(&self.hit), threads);
+        let reach = model.sides_reach(&beams, threads);
         let first = self.first_bounce(model, &beams, &reach, threads);
         let measured = model.measured_sun(&beams);
         let direct = par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, &beams, &measured) * LUMINOUS_EFFICACY) as f32);
@@ -371,8 +371,7 @@ impl SensorCoefficients {
     /// The beams' interreflected light at every sensor, lux: traced on the
     /// sides some sensor sees and where the sensors' rays land.
     fn interreflected_sun(&self, model: &LightModel, beams: &[SunBeam], threads: Option<usize>) -> Vec<f64> {
-        let sides_sun =
-            model.sun_on_sides(beams, &|side| if self.seen[side] { model.sun_samples(side) } else { 0 }, Some(&self.hit), threads);
+        let sides_sun = model.sun_on_sides(beams, &|side| if self.seen[side] { model.sun_samples(side) } else { 0 }, true, threads);
         let mut lux = self.first_bounce(model, beams, &sides_sun.reach, threads);
         add_products(&mut lux, self.later_bounces(&sides_sun.irradiance));
         lux
@@ -502,7 +501,7 @@ impl SunPath {
             let mut lux = vec![0.0; model.sensors.len()];
             add_products(
                 &mut lux,
-                coefficients.later_bounces(&model.sun_on_sides(&beams, &|side| samples[side], None, Some(1)).irradiance),
+                coefficients.later_bounces(&model.sun_on_sides(&beams, &|side| samples[side], false, Some(1)).irradiance),
             );
             lux
         });

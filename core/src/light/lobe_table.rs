@@ -123,12 +123,12 @@ impl LobeTable {
         let lights = par_map(threads, missing.len(), |k| {
             let (beams, cos) = node_beam(model, missing[k]);
             let beams = [beams];
-            let reach = model.sides_reach(&beams, Some(&coefficients.hit), Some(1));
+            let reach = model.sides_reach(&beams, Some(1));
             let first = coefficients.first_bounce(model, &beams, &reach, Some(1));
             let mut later = vec![0.0; model.sensors.len()];
             add_products(
                 &mut later,
-                coefficients.later_bounces(&model.sun_on_sides(&beams, &|side| samples[side], None, Some(1)).irradiance),
+                coefficients.later_bounces(&model.sun_on_sides(&beams, &|side| samples[side], false, Some(1)).irradiance),
             );
             let per_plane = |values: Vec<f64>| values.iter().map(|&v| (v / cos) as f32).collect();
             NodeLight { first: per_plane(first), later: per_plane(later) }
@@ -259,7 +259,7 @@ impl SensorCoefficients {
                 lobes.iter().for_each(|lobe| table.add(model, lobe, lobe.normal_irradiance * share, Some(&mut first), &mut later));
             } else {
                 // Windows in part shade: where on them the lobes leave is sharp.
-                let reach = model.sides_reach(&lobes, Some(&self.hit), threads);
+                let reach = model.sides_reach(&lobes, threads);
                 self.first_bounce(model, &lobes, &reach, threads).iter().zip(&mut first).for_each(|(v, e)| *e += v);
                 lobes.iter().for_each(|lobe| table.add(model, lobe, lobe.normal_irradiance * share, None, &mut later));
             }

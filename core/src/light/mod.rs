@@ -135,6 +135,10 @@ pub struct LightModel {
     /// tables made from the model key on it, and finding it finds the
     /// sides inside solids (88 ms on AC20-Institute-Var-2).
     cache_key: std::sync::OnceLock<u64>,
+    /// Per patch side, how many of the sensors' rays land on it: found on
+    /// first use (a pass over every landing), since a relight and every
+    /// hour of a year ask.
+    landings_on_sides: std::sync::OnceLock<Vec<u32>>,
 }
 
 /// Irradiance (W/m²) on a patch side or sensor, by channel.
@@ -293,6 +297,7 @@ impl LightModel {
             side_gathers: Vec::new(),
             sensors: Vec::new(),
             cache_key: std::sync::OnceLock::new(),
+            landings_on_sides: std::sync::OnceLock::new(),
         };
         model.look_out_of_panels();
         model.panel_samples = (0..model.panel_groups.len()).map(|g| model.window_samples(g)).collect();

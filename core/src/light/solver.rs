@@ -134,7 +134,7 @@ impl LightModel {
         let sun = sky.sun_up();
         let seen = self.key_radiance(sky);
         let beams = sun.map(|s| self.sun_beams(&s)).unwrap_or_default();
-        let sides_sun = self.sun_on_sides(&beams, &|side| self.sun_samples(side), Some(&self.sides_hit()), self.settings.threads);
+        let sides_sun = self.sun_on_sides(&beams, &|side| self.sun_samples(side), true, self.settings.threads);
         let measured = self.measured_sun(&beams);
         let direct: Vec<Channels> = par_map(self.settings.threads, patches.len() * 2, |side| {
             let gather = &self.side_gathers[side];

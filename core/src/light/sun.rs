@@ -8,7 +8,7 @@ use glam::DVec3;
 
 use super::bvh::ParallelHits;
 use super::measured::MeasuredSun;
-use super::openings::WayIn;
+use super::openings::{OpeningsAlong, WayIn};
 use super::panels::{self, SunBeam};
 use super::sampling::{Rng, sample_area};
 use super::{LightModel, SURFACE_OFFSET, Surface, par_map};
@@ -67,11 +67,13 @@ fn beam_shadows(shadows: &Shadows, b: usize) -> Option<&ParallelHits> {
     shadows.get(b).and_then(Option::as_ref)
 }
 
-/// The fewest sun samples for which a side finds its [`Shadows`] (where no
-/// sensor's rays land): the traversal costs about as much as a dozen rays,
-/// and the sun path gives sides few sensors care for 8 samples. On
-/// AC20-Institute-Var-2 with one office's sensors, finding them for every
-/// side made a year's sun path a third of the study.
+/// The fewest rays along a beam (sun samples, and the sensors' landings
+/// where their first bounce reads the side) for which a side finds its
+/// [`Shadows`]: the traversal costs about as much as a dozen rays, the sun
+/// path gives sides few sensors care for 8 samples, and many sides catch a
+/// few of the sensors' rays. On AC20-Institute-Var-2 with one office's
+/// sensors, finding them for every side made a year's sun path a third of
+/// the study.
 const SHADOWS_FROM_RAYS: usize = 16;
 
 /// The most triangles a beam's rays from a side test one by one (three
@@ -197,22 +199,26 @@ impl LightModel {
 
     /// The beams on every diffuse patch side: shadow rays from `samples(side)`
     /// seeded points of each side (0: not traced) that faces a beam and
-    /// that a beam may reach (`threads` as [`par_map`]). The reach keeps
-    /// its [`Shadows`] on the sides `keep_shadows` names (where sensors'
-    /// rays land, for their first bounce) and drops the others': a
-    /// relight of a large model holds them for a few sides, not all.
+    /// that a beam may reach (`threads` as [`par_map`]). With
+    /// `for_first_bounce` (the sensors' first bounce will read the reach),
+    /// it keeps its [`Shadows`] on the sides where sensors' rays land and
+    /// drops the others': a relight of a large model holds them for a few
+    /// sides, not all.
     pub(super) fn sun_on_sides(
         &self,
         beams: &[SunBeam],
         samples: &(dyn Fn(usize) -> usize + Sync),
-        keep_shadows: Option<&[bool]>,
+        for_first_bounce: bool,
         threads: Option<usize>,
     ) -> SidesSun {
         let patches = &self.scene.patches.patches;
+        let landed = if for_first_bounce { self.landings_on_sides() } else { &[] };
+        let along = self.openings.along(beams);
         let sides: Vec<(f64, Reach)> = par_map(threads, patches.len() * 2, |side| {
             let n = samples(side);
-            let keep = keep_shadows.is_some_and(|keep| keep[side]);
-            let reach = if n == 0 { Reach::None } else { self.side_reach(side, beams, None, keep || n >= SHADOWS_FROM_RAYS) };
+            let landings = landed.get(side).map_or(0, |&l| l as usize);
+            let keep = landings > 0;
+            let reach = if n == 0 { Reach::None } else { self.side_reach(side, beams, &along, n + landings >= SHADOWS_FROM_RAYS) };
             if reach == Reach::None {
                 return (0.0, reach);
             }
@@ -233,15 +239,20 @@ impl LightModel {
         SidesSun { irradiance, reach: SidesReach::new(reach) }
     }
 
-    /// How beams may reach every diffuse patch side (none but the sides
-    /// `wanted`, when given), without tracing.
-    pub(super) fn sides_reach(&self, beams: &[SunBeam], wanted: Option<&[bool]>, threads: Option<usize>) -> SidesReach {
-        SidesReach::new(par_map(threads, self.side_gathers.len(), |side| self.side_reach(side, beams, wanted, true)))
+    /// How beams may reach the sides where sensors' rays land (none
+    /// elsewhere), without tracing: for the sensors' first bounce.
+    pub(super) fn sides_reach(&self, beams: &[SunBeam], threads: Option<usize>) -> SidesReach {
+        let (landed, along) = (self.landings_on_sides(), self.openings.along(beams));
+        SidesReach::new(par_map(threads, self.side_gathers.len(), |side| match landed[side] as usize {
+            0 => Reach::None,
+            landings => self.side_reach(side, beams, &along, landings >= SHADOWS_FROM_RAYS),
+        }))
     }
 
-    /// How beams may reach `side`, with its [`Shadows`] when `shadows`.
-    fn side_reach(&self, side: usize, beams: &[SunBeam], wanted: Option<&[bool]>, shadows: bool) -> Reach {
-        if beams.is_empty() || wanted.is_some_and(|w| !w[side]) || self.side_reflectance(side).is_none() {
+    /// How `beams` (seen `along` them) may reach `side`, with its
+    /// [`Shadows`] when `shadows`.
+    fn side_reach(&self, side: usize, beams: &[SunBeam], along: &OpeningsAlong, shadows: bool) -> Reach {
+        if beams.is_empty() || self.side_reflectance(side).is_none() {
             return Reach::None;
         }
         let normal = self.side_normal(side as u32);
@@ -250,7 +261,7 @@ impl LightModel {
         } else if self.side_is_open(side) {
             Reach::Open(self.side_shadows(side, normal, beams, shadows))
         } else {
-            match self.openings.ways_in(side / 2, beams) {
+            match along.ways_in(side / 2) {
                 ways if ways.is_empty() => Reach::None,
                 ways => Reach::Through(ways, self.side_shadows(side, normal, beams, shadows)),
             }
@@ -286,7 +297,7 @@ impl LightModel {
         } else {
             let centre = geometry.sun_points.iter().sum::<DVec3>() / geometry.sun_points.len() as f64;
             let radius = geometry.sun_points.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
-            Reach::Through(self.openings.ways_into_sphere(centre, radius, beams), Shadows::default())
+            Reach::Through(self.openings.along(beams).ways_into_sphere(centre, radius), Shadows::default())
         };
         let total: f64 = geometry.sun_points.iter().map(|&p| self.reaching_irradiance(&reach, p, geometry.normal, beams)).sum();
         total / geometry.sun_points.len() as f64 + through_data
