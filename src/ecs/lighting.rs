@@ -1,8 +1,8 @@
 //! [`LightingPlugin`]: the light engine on Bevy's `AsyncComputeTaskPool`.
 //! A spawned scene starts the precomputation as a task; every
 //! [`LightChanged`] (or a finished precomputation) starts a relight task that
-//! sends each finished iteration back, so the view can show the light
-//! settling. A newer relight supersedes the running one: the old task stops
+//! hands each finished iteration back (replacing one not yet shown), so the
+//! view can show the light settling. A newer relight supersedes the running one: the old task stops
 //! at its next iteration, and its results are never applied. Where the light
 //! is refined for display ([`RefineForDisplay`], the viewer), a second
 //! precomputation with more patch rays follows once the first light is
@@ -13,7 +13,6 @@
 //! as `sensors` and `annual` compute them.
 
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::mpsc::{Receiver, channel};
 use std::sync::{Arc, Mutex};
 
 use bevy::prelude::*;
@@ -79,7 +78,11 @@ pub struct LightEngine {
     refinement: Option<(Arc<crate::scene::Scene>, light::LightSettings)>,
     /// Generation of the newest relight; older tasks stop when they see it move on.
     generation: Arc<AtomicU64>,
-    results: Option<Mutex<Receiver<RelightResult>>>,
+    /// The newest relight's newest iteration not yet applied: each replaces
+    /// the one before, so a view drawing slower than the light settles
+    /// (a large model on a software rasterizer) holds one, not a queue of
+    /// them (AC20-Institute-Var-2: 11 MB each, 25 waiting).
+    results: Option<Arc<Mutex<Option<RelightResult>>>>,
     relight_pending: bool,
 }
 
@@ -230,8 +233,8 @@ fn start_relight(
     // Where the light shown is the smoothed model's, the converged sensors
     // still read as `sensors` reads them: from the settings' own model.
     let numbers = engine.smoothed.as_ref().and(engine.model.clone());
-    let (sender, receiver) = channel();
-    engine.results = Some(Mutex::new(receiver));
+    let newest = Arc::new(Mutex::new(None));
+    engine.results = Some(newest.clone());
     AsyncComputeTaskPool::get()
         .spawn(async move {
             let mut relight = model.relight(&sky, warm.as_ref());
@@ -241,10 +244,12 @@ fn start_relight(
                 if converged && let Some(numbers) = &numbers {
                     lighting.sensors = numbers.solve(&sky, None).sensors;
                 }
-                if current.load(Ordering::SeqCst) != generation
-                    || sender.send(RelightResult { generation, lighting, converged }).is_err()
-                    || converged
-                {
+                // Gone: a newer relight, another scene, or the app closed.
+                if current.load(Ordering::SeqCst) != generation || Arc::strong_count(&newest) == 1 {
+                    return;
+                }
+                *newest.lock().expect("relight results lock") = Some(RelightResult { generation, lighting, converged });
+                if converged {
                     return;
                 }
                 relight.step();
@@ -256,7 +261,7 @@ fn start_relight(
 fn apply_relight(engine: Res<LightEngine>, mut state: ResMut<LightingState>, mut updated: MessageWriter<LightingUpdated>) {
     let Some(results) = &engine.results else { return };
     let newest = engine.generation.load(Ordering::SeqCst);
-    let latest = results.lock().expect("relight results lock").try_iter().filter(|r| r.generation == newest).last();
+    let latest = results.lock().expect("relight results lock").take().filter(|r| r.generation == newest);
     if let Some(result) = latest {
         *state = LightingState { lighting: Some(result.lighting), generation: result.generation, converged: result.converged };
         updated.write(LightingUpdated { generation: result.generation, converged: result.converged });

@@ -20,8 +20,10 @@ use bevy::camera::Exposure;
 use bevy::camera::Hdr;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
-use bevy::render::render_resource::TextureUsages;
+use bevy::render::render_resource::{PollType, TextureUsages};
+use bevy::render::renderer::{RenderAdapterInfo, RenderDevice};
 use bevy::render::view::Msaa;
+use bevy::render::{Render, RenderApp, RenderSystems};
 
 use crate::ecs::{ActiveScene, HeliodonSystems, LightEngine, LightingState, SunSky};
 use crate::light::{Channels, LightModel, side_of};
@@ -61,6 +63,21 @@ impl Plugin for HeliodonRenderPlugin {
             .add_plugins((SurfaceLightingPlugin, SunPassPlugin, sky::SkyBackgroundPlugin))
             .add_systems(Update, (update_sun_pass, surfaces::update_panel_looks).in_set(HeliodonRenderSystems::SunPass))
             .add_systems(Update, (auto_exposure, tone_mapping_for_mode).in_set(HeliodonRenderSystems::Exposure));
+        if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
+            render_app.add_systems(Render, wait_for_software_rasterizer.before(RenderSystems::PrepareAssets));
+        }
+    }
+}
+
+/// On a software rasterizer (Mesa's lavapipe), each frame starts once the
+/// last one is drawn. There nothing else bounds the frames in flight: while
+/// the light settles, frames and the patch meshes' uploads queued faster
+/// than the CPU drew them, and the viewer of AC20-Institute-Var-2 held
+/// 2.3 GB of them. A GPU keeps its own pace.
+fn wait_for_software_rasterizer(adapter: Res<RenderAdapterInfo>, device: Res<RenderDevice>) {
+    if adapter.device_type == wgpu_types::DeviceType::Cpu {
+        // A lost device fails the frame's own submissions with its message.
+        let _ = device.poll(PollType::wait_indefinitely());
     }
 }
 

@@ -312,7 +312,8 @@ impl SensorCoefficients {
     pub fn readings(&self, model: &LightModel, sky: &Sky, threads: Option<usize>) -> Vec<SensorReading> {
         let beams = sky.sun_up().map(|s| model.sun_beams(&s)).unwrap_or_default();
         let measured = model.measured_sun(&beams);
-        let direct = par_map(threads, model.sensors.len(), |i| model.sensor_direct_sun(i, &beams, &measured) * LUMINOUS_EFFICACY);
+        let direct_sun = model.sensors_sun(&beams, &measured);
+        let direct = par_map(threads, model.sensors.len(), |i| model.sensor_direct_sun(i, &direct_sun) * LUMINOUS_EFFICACY);
         let sun = SunLux { direct, interreflected: self.interreflected_sun(model, &beams, threads) };
         self.read(model, model.key_radiance(sky), sun, threads)
     }
@@ -347,7 +348,8 @@ impl SensorCoefficients {
         let reach = model.sides_reach(&beams, threads);
         let first = self.first_bounce(model, &beams, &reach, threads);
         let measured = model.measured_sun(&beams);
-        let direct = par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, &beams, &measured) * LUMINOUS_EFFICACY) as f32);
+        let direct_sun = model.sensors_sun(&beams, &measured);
+        let direct = par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, &direct_sun) * LUMINOUS_EFFICACY) as f32);
         let interreflected = first.iter().zip(path.later_bounces(direction)).map(|(first, later)| (first + later) as f32).collect();
         SunResponse { direct, interreflected }
     }

@@ -246,8 +246,8 @@ impl SensorCoefficients {
                 Some(_) => None,
             })
             .collect();
-        let direct =
-            par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, &direct_beams, &measured) * LUMINOUS_EFFICACY) as f32);
+        let direct_sun = model.sensors_sun(&direct_beams, &measured);
+        let direct = par_map(threads, model.sensors.len(), |i| (model.sensor_direct_sun(i, &direct_sun) * LUMINOUS_EFFICACY) as f32);
         let mut first = vec![0.0; model.sensors.len()];
         let mut later = vec![0.0; model.sensors.len()];
         for (&group, &(share, even)) in table.groups.iter().zip(&sunlit.0) {

@@ -136,6 +136,7 @@ impl LightModel {
         let beams = sun.map(|s| self.sun_beams(&s)).unwrap_or_default();
         let sides_sun = self.sun_on_sides(&beams, &|side| self.sun_samples(side), true, self.settings.threads);
         let measured = self.measured_sun(&beams);
+        let direct_sun = self.sensors_sun(&beams, &measured);
         let direct: Vec<Channels> = par_map(self.settings.threads, patches.len() * 2, |side| {
             let gather = &self.side_gathers[side];
             if self.side_reflectance(side).is_none() {
@@ -153,7 +154,7 @@ impl LightModel {
         // Each sensor's direct light and the first bounce of sun where its rays land.
         let sensors: Vec<SensorDirect> = par_map(self.settings.threads, self.sensors.len(), |i| {
             let geometry = &self.sensors[i];
-            let sun = seen.panel_sun_irradiance(&geometry.gather) + self.sensor_direct_sun(i, &beams, &measured);
+            let sun = seen.panel_sun_irradiance(&geometry.gather) + self.sensor_direct_sun(i, &direct_sun);
             SensorDirect {
                 sky: seen.sky_irradiance(&geometry.gather),
                 sun,

@@ -67,6 +67,14 @@ fn beam_shadows(shadows: &Shadows, b: usize) -> Option<&ParallelHits> {
     shadows.get(b).and_then(Option::as_ref)
 }
 
+/// The beams the sensors' direct sun follows (those measured data does not
+/// cover) and their ways in ([`LightModel::sensors_sun`]).
+pub(super) struct SensorsSun<'a> {
+    beams: Vec<SunBeam>,
+    along: OpeningsAlong<'a>,
+    measured: &'a MeasuredSun,
+}
+
 /// The fewest rays along a beam (sun samples, and the sensors' landings
 /// where their first bounce reads the side) for which a side finds its
 /// [`Shadows`]: the traversal costs about as much as a dozen rays, the sun
@@ -282,22 +290,27 @@ impl LightModel {
         beams.iter().map(|beam| if faced(beam) { shadows(beam) } else { None }).collect()
     }
 
-    /// Sensor `index`'s direct sun (W/m², averaged over its sun points):
-    /// the beams, and through panels with measured transmission their data
-    /// (`measured`, [`Self::measured_sun`] of the same beams) in place of
-    /// their beams. An enclosed sensor (no gather ray reached the open sky)
-    /// is traced only along beams that may pass a window, as sides are.
-    pub(super) fn sensor_direct_sun(&self, index: usize, beams: &[SunBeam], measured: &MeasuredSun) -> f64 {
-        let through_data: f64 = self.sensor_measured_sun(index, measured).iter().map(|w| w.1).sum();
+    /// The sensors' direct sun from `beams`, made once for all of them:
+    /// through panels with measured transmission their data (`measured`,
+    /// [`Self::measured_sun`] of the same beams) in place of their beams.
+    pub(super) fn sensors_sun<'a>(&'a self, beams: &[SunBeam], measured: &'a MeasuredSun) -> SensorsSun<'a> {
         let beams: Vec<SunBeam> = beams.iter().filter(|b| !measured.covers(b.panel_group)).copied().collect();
-        let beams = &beams[..];
+        SensorsSun { along: self.openings.along(&beams), beams, measured }
+    }
+
+    /// Sensor `index`'s direct sun (W/m², averaged over its sun points).
+    /// An enclosed sensor (no gather ray reached the open sky) is traced
+    /// only along beams that may pass a window, as sides are.
+    pub(super) fn sensor_direct_sun(&self, index: usize, sun: &SensorsSun) -> f64 {
+        let through_data: f64 = self.sensor_measured_sun(index, sun.measured).iter().map(|w| w.1).sum();
+        let beams = &sun.beams[..];
         let geometry = &self.sensors[index];
         let reach = if self.sees_open_sky(&geometry.gather) || beams.is_empty() {
             Reach::Open(Shadows::default())
         } else {
             let centre = geometry.sun_points.iter().sum::<DVec3>() / geometry.sun_points.len() as f64;
             let radius = geometry.sun_points.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
-            Reach::Through(self.openings.along(beams).ways_into_sphere(centre, radius), Shadows::default())
+            Reach::Through(sun.along.ways_into_sphere(centre, radius), Shadows::default())
         };
         let total: f64 = geometry.sun_points.iter().map(|&p| self.reaching_irradiance(&reach, p, geometry.normal, beams)).sum();
         total / geometry.sun_points.len() as f64 + through_data
