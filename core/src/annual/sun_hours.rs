@@ -40,7 +40,7 @@ use crate::sun::{direction_from_angles, solar_position};
 use crate::weather::{HOURS, calendar};
 
 /// Bump when the table or how it is traced changes.
-const FORMAT: u32 = 3;
+const FORMAT: u32 = 4;
 
 /// The most a table may take on disk, bytes. Past it (a grid of tens of
 /// thousands of sensors) the year's sun is traced hour by hour instead

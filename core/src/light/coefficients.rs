@@ -47,7 +47,20 @@ use crate::sky::{LUMINOUS_EFFICACY, Sky, SunSource};
 const BLOCK: usize = 32;
 
 /// Bump when the coefficients or how they are stored change.
-const FORMAT: u32 = 1;
+const FORMAT: u32 = 2;
+
+/// A side passes its importance on to the sides it sees only where it is
+/// above this share of the largest importance of the same sensor and
+/// channel. Far from a sensor's room the importance falls by orders of
+/// magnitude per bounce (out by a window, off a façade, in by another
+/// window), yet the exact iteration spreads it over the building. Below a
+/// millionth it changes no reading beyond rounding: on
+/// AC20-Institute-Var-2 with one office's sensors a block's importance
+/// reaches 11,724 of 86,872 sides (61,934 without it), the year's
+/// sun is traced on those alone, a cold `annual` takes 16.3 s (33.8 s) and
+/// its hourly values move by 0.016% at the 99th percentile (one lux of
+/// rounding at most).
+const IMPORTANCE_FLOOR: f32 = 1e-6;
 
 /// The most coefficients kept in the light cache, bytes: past it (a grid of
 /// tens of thousands of sensors) they are solved each run instead.
@@ -191,6 +204,7 @@ impl LightModel {
         let tolerance = 0.1 * self.settings.tolerance as f32;
         let mut u = source.clone();
         let mut iterations = 0;
+        let mut passing = importance_passed_on(&u, width);
         loop {
             let rows_per_task = sides.div_ceil(64).max(1);
             let next: Vec<f32> = par_map(self.settings.threads, sides.div_ceil(rows_per_task), |task| {
@@ -200,7 +214,7 @@ impl LightModel {
                 for (local, j) in rows.enumerate() {
                     let row = &mut out[local * width..(local + 1) * width];
                     gathered.fill(0.0);
-                    for &(i, f) in &columns[j] {
+                    for &(i, f) in columns[j].iter().filter(|&&(i, _)| passing[i as usize]) {
                         for (g, &x) in gathered.iter_mut().zip(&u[i as usize * width..(i as usize + 1) * width]) {
                             *g += f * x;
                         }
@@ -224,6 +238,7 @@ impl LightModel {
                 size[k % width] = size[k % width].max(a.abs());
             }
             u = next;
+            passing = importance_passed_on(&u, width);
             if change.iter().zip(&size).all(|(c, s)| *c <= tolerance * s) || iterations >= self.settings.max_iterations {
                 break;
             }
@@ -239,6 +254,18 @@ impl LightModel {
             .collect();
         (weights, iterations)
     }
+}
+
+/// Per side, whether its importance `u` (rows of `width` right-hand sides)
+/// is passed on: above [`IMPORTANCE_FLOOR`] of its column's largest for
+/// some right-hand side.
+fn importance_passed_on(u: &[f32], width: usize) -> Vec<bool> {
+    let mut largest = vec![0.0f32; width];
+    for row in u.chunks_exact(width) {
+        largest.iter_mut().zip(row).for_each(|(l, x)| *l = l.max(x.abs()));
+    }
+    let floor: Vec<f32> = largest.iter().map(|l| IMPORTANCE_FLOOR * l).collect();
+    u.chunks_exact(width).map(|row| row.iter().zip(&floor).any(|(x, f)| x.abs() > *f)).collect()
 }
 
 /// The sun's light at every sensor per W/m² of direct normal irradiance,
