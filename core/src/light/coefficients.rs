@@ -204,24 +204,32 @@ impl LightModel {
         let tolerance = 0.1 * self.settings.tolerance as f32;
         let mut u = source.clone();
         let mut iterations = 0;
-        let mut passing = importance_passed_on(&u, width);
+        // Only rows that a passing side gathers into (and the sources) can
+        // change; every other row is 0. `live`: the rows that may not be.
+        let sourced: Vec<u32> = (0..sides as u32).filter(|&j| row_of(&source, j, width).iter().any(|&x| x != 0.0)).collect();
+        let mut live = sourced.clone();
+        let mut passing = importance_passed_on(&u, width, &live);
         loop {
-            let rows_per_task = sides.div_ceil(64).max(1);
-            let next: Vec<f32> = par_map(self.settings.threads, sides.div_ceil(rows_per_task), |task| {
-                let rows = task * rows_per_task..((task + 1) * rows_per_task).min(sides);
-                let mut out = source[rows.start * width..rows.end * width].to_vec();
+            let mut target = vec![false; sides];
+            sourced.iter().for_each(|&j| target[j as usize] = true);
+            for &i in live.iter().filter(|&&i| passing[i as usize]) {
+                self.side_gathers[i as usize].form_factors.iter().for_each(|&(j, _)| target[j as usize] = true);
+            }
+            let rows: Vec<u32> = (0..sides as u32).filter(|&j| target[j as usize]).collect();
+            let rows_per_task = rows.len().div_ceil(64).max(1);
+            let next: Vec<f32> = par_map(self.settings.threads, rows.len().div_ceil(rows_per_task), |task| {
+                let rows = &rows[task * rows_per_task..((task + 1) * rows_per_task).min(rows.len())];
+                let mut out = Vec::with_capacity(rows.len() * width);
                 let mut gathered = vec![0.0f32; width];
-                for (local, j) in rows.enumerate() {
-                    let row = &mut out[local * width..(local + 1) * width];
+                for &j in rows {
                     gathered.fill(0.0);
-                    for &(i, f) in columns[j].iter().filter(|&&(i, _)| passing[i as usize]) {
-                        for (g, &x) in gathered.iter_mut().zip(&u[i as usize * width..(i as usize + 1) * width]) {
+                    for &(i, f) in columns[j as usize].iter().filter(|&&(i, _)| passing[i as usize]) {
+                        for (g, &x) in gathered.iter_mut().zip(row_of(&u, i, width)) {
                             *g += f * x;
                         }
                     }
-                    for (r, (o, g)) in row.iter_mut().zip(&gathered).enumerate() {
-                        *o += reflectance[j][r % 3] * g;
-                    }
+                    let row = row_of(&source, j, width).iter().zip(&gathered).enumerate();
+                    out.extend(row.map(|(r, (o, g))| o + reflectance[j as usize][r % 3] * g));
                 }
                 out
             })
@@ -233,12 +241,21 @@ impl LightModel {
             // tolerance of its largest weight.
             let mut change = vec![0.0f32; width];
             let mut size = vec![0.0f32; width];
-            for (k, (a, b)) in next.iter().zip(&u).enumerate() {
-                change[k % width] = change[k % width].max((a - b).abs());
-                size[k % width] = size[k % width].max(a.abs());
+            for &j in live.iter().filter(|&&j| !target[j as usize]) {
+                let old = &mut u[j as usize * width..(j as usize + 1) * width];
+                old.iter().zip(&mut change).for_each(|(b, c)| *c = c.max(b.abs()));
+                old.fill(0.0);
             }
-            u = next;
-            passing = importance_passed_on(&u, width);
+            for (&j, new) in rows.iter().zip(next.chunks_exact(width)) {
+                let old = &mut u[j as usize * width..(j as usize + 1) * width];
+                for (k, (a, b)) in new.iter().zip(old.iter_mut()).enumerate() {
+                    change[k] = change[k].max((a - *b).abs());
+                    size[k] = size[k].max(a.abs());
+                    *b = *a;
+                }
+            }
+            live = rows;
+            passing = importance_passed_on(&u, width, &live);
             if change.iter().zip(&size).all(|(c, s)| *c <= tolerance * s) || iterations >= self.settings.max_iterations {
                 break;
             }
@@ -256,16 +273,25 @@ impl LightModel {
     }
 }
 
-/// Per side, whether its importance `u` (rows of `width` right-hand sides)
-/// is passed on: above [`IMPORTANCE_FLOOR`] of its column's largest for
-/// some right-hand side.
-fn importance_passed_on(u: &[f32], width: usize) -> Vec<bool> {
+/// Row `j` of `values` (rows of `width`).
+fn row_of(values: &[f32], j: u32, width: usize) -> &[f32] {
+    &values[j as usize * width..(j as usize + 1) * width]
+}
+
+/// Per side, whether its importance `u` (rows of `width` right-hand sides,
+/// zero but on the rows `live`) is passed on: above [`IMPORTANCE_FLOOR`]
+/// of its column's largest for some right-hand side.
+fn importance_passed_on(u: &[f32], width: usize, live: &[u32]) -> Vec<bool> {
     let mut largest = vec![0.0f32; width];
-    for row in u.chunks_exact(width) {
-        largest.iter_mut().zip(row).for_each(|(l, x)| *l = l.max(x.abs()));
+    for &j in live {
+        largest.iter_mut().zip(row_of(u, j, width)).for_each(|(l, x)| *l = l.max(x.abs()));
     }
     let floor: Vec<f32> = largest.iter().map(|l| IMPORTANCE_FLOOR * l).collect();
-    u.chunks_exact(width).map(|row| row.iter().zip(&floor).any(|(x, f)| x.abs() > *f)).collect()
+    let mut passing = vec![false; u.len() / width.max(1)];
+    for &j in live {
+        passing[j as usize] = row_of(u, j, width).iter().zip(&floor).any(|(x, f)| x.abs() > *f);
+    }
+    passing
 }
 
 /// The sun's light at every sensor per W/m² of direct normal irradiance,
