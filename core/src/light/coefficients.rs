@@ -57,7 +57,7 @@ const FORMAT: u32 = 2;
 /// millionth it changes no reading beyond rounding: on
 /// AC20-Institute-Var-2 with one office's sensors a block's importance
 /// reaches 11,724 of 86,872 sides (61,934 without it), the year's
-/// sun is traced on those alone, a cold `annual` takes 16.3 s (33.8 s) and
+/// sun is traced on those alone, a cold `annual` takes 17.3 s (33.7 s) and
 /// its hourly values move by 0.016% at the 99th percentile (one lux of
 /// rounding at most).
 const IMPORTANCE_FLOOR: f32 = 1e-6;
