@@ -69,20 +69,15 @@ impl Openings {
     fn across(&self, beam: &SunBeam) -> WindowsAcross {
         let ray = Ray::new(beam.to_light);
         let (u, v) = beam.to_light.any_orthonormal_pair();
-        let rects: Vec<(u32, [f64; 4])> = (self.windows.iter().enumerate())
+        let rects: Vec<(u32, Rect)> = (self.windows.iter().enumerate())
             .filter(|(_, (_, group))| *group == beam.panel_group)
             .map(|(w, ([min, max], _))| {
                 let corners = (0..8).map(|k| DVec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), *max, *min));
-                let rect = corners.fold([f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY], |r, c| {
-                    let (a, b) = (c.dot(u), c.dot(v));
-                    [r[0].min(a), r[1].max(a), r[2].min(b), r[3].max(b)]
-                });
+                let rect = corners.fold(NO_RECT, |r, c| union(r, [c.dot(u), c.dot(u), c.dot(v), c.dot(v)]));
                 (w as u32, rect)
             })
             .collect();
-        let bounds = rects.iter().fold([f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY], |b, (_, r)| {
-            [b[0].min(r[0]), b[1].max(r[1]), b[2].min(r[2]), b[3].max(r[3])]
-        });
+        let bounds = rects.iter().fold(NO_RECT, |b, (_, r)| union(b, *r));
         let cells = ((2.0 * (rects.len() as f64).sqrt()).ceil() as usize).clamp(1, MAX_CELLS_ACROSS);
         let grid = Grid {
             u,
@@ -127,6 +122,15 @@ impl Openings {
             })
         })
     }
+}
+
+/// A rectangle `[a0, a1, b0, b1]` in a plane's (u, v), and the empty one.
+type Rect = [f64; 4];
+const NO_RECT: Rect = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
+
+/// The smallest rectangle holding `r` and `s`.
+fn union(r: Rect, s: Rect) -> Rect {
+    [r[0].min(s[0]), r[1].max(s[1]), r[2].min(s[2]), r[3].max(s[3])]
 }
 
 /// The most grid cells along each axis of a [`WindowsAcross`].
