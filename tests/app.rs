@@ -461,13 +461,22 @@ fn relights_run_as_tasks_and_the_last_change_wins() {
 /// shown first, then a precomputation with the display's patch rays runs in
 /// the background, and the light shown is that smoothed model's, as a fresh
 /// solve gives it; the sensors read as the settings' own model gives them.
+/// Each precomputation wakes the app (`LightWaker`) once its model is there
+/// to take, and changes nothing shown while it runs.
 #[test]
 fn the_light_shown_is_smoothed_after_it_appears() {
-    use heliodon::ecs::{self, LightCacheDir, LightEngine, LightingState, RefineForDisplay, SunSky};
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    use heliodon::ecs::{self, LightCacheDir, LightEngine, LightWaker, LightingState, RefineForDisplay, SunSky};
 
     let base = quick_light();
     let mut app = headless_app();
     app.insert_resource(ecs::LightSettings(base)).insert_resource(LightCacheDir(None)).insert_resource(RefineForDisplay(true));
+    let wakes = Arc::new(AtomicUsize::new(0));
+    let counted = wakes.clone();
+    app.insert_resource(LightWaker(Arc::new(move || {
+        counted.fetch_add(1, Ordering::SeqCst);
+    })));
     open(&mut app, heliodon::bundled_scene("test_room")).unwrap();
     let (mut shown_first, mut smoothed_after) = (false, false);
     let deadline = Instant::now() + Duration::from_secs(120);
@@ -477,6 +486,10 @@ fn the_light_shown_is_smoothed_after_it_appears() {
         let (engine, state) = (world.resource::<LightEngine>(), world.resource::<LightingState>());
         shown_first |= state.converged && engine.model.is_some() && engine.smoothed.is_none() && engine.is_smoothing();
         smoothed_after |= shown_first && engine.smoothed.is_some();
+        if engine.is_precomputing() && engine.model.is_none() {
+            assert!(!engine.is_relighting(state), "nothing to show while the first precomputation runs");
+            assert!(state.lighting.is_none());
+        }
         if smoothed_after && !engine.is_smoothing() && !engine.is_settling(state) {
             break;
         }
@@ -499,6 +512,7 @@ fn the_light_shown_is_smoothed_after_it_appears() {
     let numbers = engine.model.as_ref().unwrap().solve(sky, None);
     assert_eq!(shown.sensors, numbers.sensors);
     assert!(shown.sensors.iter().zip(&fresh.sensors).any(|(a, b)| a.total != b.total));
+    assert_eq!(wakes.load(Ordering::SeqCst), 2, "one wake per precomputation: the settings' own and the display's");
 }
 
 /// Renders the direct sun of a view and compares it with the CPU reference

@@ -20,7 +20,9 @@ named after the space (its LongName; see `space_names` where long names repeat):
 a sensor grid where the space fills its box, otherwise the grid's points
 over the space's floor as point sensors `<space>/<k>` (an L-shaped
 corridor's box reaches into the rooms beside it). The site's latitude and
-longitude come from IfcSite when given there.
+longitude come from IfcSite when given there, and without --timezone the
+standard time is that of the meridian nearest the longitude (said so: an
+IFC site names no time zone, and UTC at Chicago puts noon at 6 a.m.).
 """
 import argparse
 import os
@@ -145,7 +147,7 @@ def main():
     ap.add_argument("out")
     ap.add_argument("--latitude", type=float)
     ap.add_argument("--longitude", type=float)
-    ap.add_argument("--timezone", type=float, default=0.0)
+    ap.add_argument("--timezone", type=float)
     ap.add_argument("--spacing", type=float, default=0.5)
     ap.add_argument("--transmittance", type=float, default=0.78)
     a = ap.parse_args()
@@ -227,9 +229,13 @@ def main():
     site = next(iter(model.by_type("IfcSite")), None)
     latitude = a.latitude if a.latitude is not None else (angle(site.RefLatitude) if site and site.RefLatitude else 0.0)
     longitude = a.longitude if a.longitude is not None else (angle(site.RefLongitude) if site and site.RefLongitude else 0.0)
+    timezone = a.timezone
+    if timezone is None:
+        timezone = float(round(longitude / 15.0))
+        print(f"timezone {timezone:+.0f} h: the meridian nearest longitude {longitude:.2f}° (give --timezone for the site's own)")
     with open(os.path.join(a.out, "scene.toml"), "w") as f:
         f.write(f'name = "{os.path.basename(a.ifc)}"\n\n[site]\nlatitude = {latitude:.4f}\nlongitude = {longitude:.4f}\n'
-                f'timezone = {a.timezone}\n\n[model]\nobj = "model.obj"\n')
+                f'timezone = {timezone}\n\n[model]\nobj = "model.obj"\n')
         used = set()
         partial = 0
         for name, lo, hi, floor in spaces:

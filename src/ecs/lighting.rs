@@ -15,8 +15,9 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
+use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
-use bevy::tasks::{AsyncComputeTaskPool, Task, block_on, futures_lite::future};
+use bevy::tasks::{AsyncComputeTaskPool, Task};
 
 use super::{ActiveScene, HeliodonSystems, LightChanged, SceneSpawned, SunSky};
 use crate::light::{self, LightModel, Lighting, cache};
@@ -63,6 +64,20 @@ impl Default for LightCacheDir {
     }
 }
 
+/// Called from a precomputation's task once its result is ready: a window
+/// that draws only when asked (the viewer) need not draw frame after frame
+/// to see a precomputation end (on a software rasterizer those frames took
+/// a third of the cores from it). Without one, the app updates anyway.
+#[derive(Resource, Clone)]
+pub struct LightWaker(pub Arc<dyn Fn() + Send + Sync>);
+
+/// A precomputation in flight: its task (dropped, it is cancelled if not
+/// yet started) and where it leaves its model before it wakes the app.
+struct Precompute {
+    _task: Task<()>,
+    result: Arc<Mutex<Option<Result<LightModel, String>>>>,
+}
+
 /// The precomputed model and the work in flight.
 #[derive(Resource, Default)]
 pub struct LightEngine {
@@ -72,7 +87,7 @@ pub struct LightEngine {
     /// The same with the display's patch rays, once precomputed
     /// ([`RefineForDisplay`]): the light shown comes from it.
     pub smoothed: Option<Arc<LightModel>>,
-    precompute: Option<Task<Result<LightModel, String>>>,
+    precompute: Option<Precompute>,
     /// The precomputation for display still to start (once the first
     /// light is shown). One in flight while `model` is there is it.
     refinement: Option<(Arc<crate::scene::Scene>, light::LightSettings)>,
@@ -104,11 +119,17 @@ impl LightEngine {
     }
 
     /// Whether the light is still on its way to `state`: precomputing (for
-    /// display too), a relight asked for, or the newest relight not yet
-    /// shown converged.
+    /// display too) or relighting.
     pub fn is_settling(&self, state: &LightingState) -> bool {
-        self.is_precomputing()
-            || self.relight_pending
+        self.is_precomputing() || self.is_relighting(state)
+    }
+
+    /// Whether the light shown is changing: a relight asked for with a
+    /// model to relight, or the newest relight not yet shown converged. (A
+    /// precomputation changes nothing shown until it ends; a relight asked
+    /// for before there is a model waits for it.)
+    pub fn is_relighting(&self, state: &LightingState) -> bool {
+        (self.relight_pending && self.model.is_some())
             || (self.results.is_some() && !(state.converged && state.generation == self.generation()))
     }
 }
@@ -147,7 +168,7 @@ fn start_precompute(
     active: Res<ActiveScene>,
     settings: Res<LightSettings>,
     refine: Res<RefineForDisplay>,
-    cache_dir: Res<LightCacheDir>,
+    precomputer: Precomputer,
     mut engine: ResMut<LightEngine>,
     mut state: ResMut<LightingState>,
 ) {
@@ -163,24 +184,40 @@ fn start_precompute(
     *state = LightingState::default();
     let display = settings.for_display(scene.patches.patches.len());
     engine.refinement = (refine.0 && display != settings).then(|| (scene.clone(), display));
-    engine.precompute = Some(precompute_task(scene, settings, &cache_dir));
+    engine.precompute = Some(precomputer.spawn(scene, settings));
 }
 
-/// The precomputation of `scene` with `settings` (or its cached model) as a task.
-fn precompute_task(
-    scene: Arc<crate::scene::Scene>,
-    settings: light::LightSettings,
-    cache_dir: &LightCacheDir,
-) -> Task<Result<LightModel, String>> {
-    let dir = cache_dir.0.clone();
-    // The viewer meters exposure by tracing the model in a frame.
-    AsyncComputeTaskPool::get()
-        .spawn(async move { cache::precompute_cached(scene, settings, dir.as_deref(), &|_| {}).map(|(model, _)| model.with_tracer()) })
+/// What a precomputation needs besides its scene and settings: where it
+/// is cached, and whom it wakes.
+#[derive(SystemParam)]
+struct Precomputer<'w> {
+    cache_dir: Res<'w, LightCacheDir>,
+    waker: Option<Res<'w, LightWaker>>,
+}
+
+impl Precomputer<'_> {
+    /// The precomputation of `scene` with `settings` (or its cached model)
+    /// as a task, which wakes the app when its model is there to take.
+    fn spawn(&self, scene: Arc<crate::scene::Scene>, settings: light::LightSettings) -> Precompute {
+        let dir = self.cache_dir.0.clone();
+        let waker = self.waker.as_deref().cloned();
+        let result = Arc::new(Mutex::new(None));
+        let slot = result.clone();
+        let task = AsyncComputeTaskPool::get().spawn(async move {
+            // The viewer meters exposure by tracing the model in a frame.
+            let model = cache::precompute_cached(scene, settings, dir.as_deref(), &|_| {}).map(|(model, _)| model.with_tracer());
+            *slot.lock().expect("precomputation result lock") = Some(model);
+            if let Some(LightWaker(wake)) = waker {
+                wake();
+            }
+        });
+        Precompute { _task: task, result }
+    }
 }
 
 fn finish_precompute(mut engine: ResMut<LightEngine>, mut failed: MessageWriter<LightingFailed>) {
-    let Some(task) = engine.precompute.as_mut() else { return };
-    let Some(result) = block_on(future::poll_once(task)) else { return };
+    let Some(precompute) = engine.precompute.as_ref() else { return };
+    let Some(result) = precompute.result.lock().expect("precomputation result lock").take() else { return };
     engine.precompute = None;
     match result {
         Ok(model) => {
@@ -202,13 +239,13 @@ fn finish_precompute(mut engine: ResMut<LightEngine>, mut failed: MessageWriter<
 
 /// Starts the precomputation for display once the first light is shown
 /// (converged), so that it never holds that light back.
-fn start_refinement(state: Res<LightingState>, cache_dir: Res<LightCacheDir>, mut engine: ResMut<LightEngine>) {
+fn start_refinement(state: Res<LightingState>, precomputer: Precomputer, mut engine: ResMut<LightEngine>) {
     let shown = state.converged && state.generation == engine.generation() && !engine.relight_pending;
     if engine.precompute.is_some() || !shown {
         return;
     }
     if let Some((scene, settings)) = engine.refinement.take() {
-        engine.precompute = Some(precompute_task(scene, settings, &cache_dir));
+        engine.precompute = Some(precomputer.spawn(scene, settings));
     }
 }
 

@@ -13,7 +13,7 @@ use bevy::app::PluginGroupBuilder;
 use bevy::prelude::*;
 
 pub use lighting::{
-    LightCacheDir, LightEngine, LightSettings, LightingFailed, LightingPlugin, LightingState, LightingUpdated, RefineForDisplay,
+    LightCacheDir, LightEngine, LightSettings, LightWaker, LightingFailed, LightingPlugin, LightingState, LightingUpdated, RefineForDisplay,
 };
 pub use scene_asset::{PanelRegistry, RegisterPanel, SceneAsset, SceneLoader, describe_load_failure, scene_asset_path};
 pub use scene_plugin::{

@@ -2,25 +2,30 @@
 //! desktop update mode): a frame comes on input and window events, egui's
 //! own repaint requests, or a [`RequestRedraw`]; an idle viewer draws
 //! nothing. While something moves on its own, it asks for the next frame:
-//! the scene loading, the light being precomputed or settling, a sensor's
-//! day or year, the annual study or a sweep in the background. (The day
-//! playing asks in `ui::sun_and_sky::play_the_day`.) bevy_egui's every-frame
-//! modifier event is filtered, or egui would never let the window rest. The batch flow
-//! (`view --screenshot/--hdr`) keeps drawing continuously.
+//! the scene loading, the light settling, a sensor's day or year, the
+//! annual study or a sweep in the background. (The day playing asks in
+//! `ui::sun_and_sky::play_the_day`.) A precomputation of the light shows
+//! nothing until it ends, so the window sleeps through it and its task
+//! wakes the window when done ([`LightWaker`]): frames drawn meanwhile
+//! only took cores from it (on a software rasterizer a third of them, KIT's
+//! early-design institute). bevy_egui's every-frame modifier event is
+//! filtered, or egui would never let the window rest. The batch flow
+//! (`view --screenshot/--hdr`) draws continuously but for the same sleep.
 
 use std::collections::VecDeque;
+use std::sync::{Arc, Mutex};
 
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy::window::RequestRedraw;
-use bevy::winit::WinitSettings;
+use bevy::winit::{EventLoopProxyWrapper, WinitSettings, WinitUserEvent};
 use bevy_egui::{EguiInput, EguiPreUpdateSet, egui};
 
 use super::ViewStart;
 use super::annual::AnnualStudy;
 use super::sensors::{DaySeries, YearMap};
 use super::sweep::SweepStudy;
-use crate::ecs::{ActiveScene, LightEngine, LightingState};
+use crate::ecs::{ActiveScene, LightEngine, LightWaker, LightingState};
 
 /// Reactive drawing for a person at the window, continuous for a batch job.
 pub struct RedrawPlugin;
@@ -28,7 +33,8 @@ pub struct RedrawPlugin;
 impl Plugin for RedrawPlugin {
     fn build(&self, app: &mut App) {
         app.insert_resource(WinitSettings::desktop_app())
-            .add_systems(Startup, draw_continuously_for_batch)
+            .add_systems(Startup, wake_for_the_light)
+            .add_systems(Last, draw_continuously_for_batch)
             .add_systems(PreUpdate, drop_unchanged_modifiers.after(EguiPreUpdateSet::ProcessInput).before(EguiPreUpdateSet::BeginPass))
             .init_resource::<DrawnFrameTimes>()
             .add_systems(First, time_drawn_frames)
@@ -66,9 +72,25 @@ fn time_drawn_frames(time: Res<Time<Real>>, mut asked: MessageReader<RequestRedr
     }
 }
 
-fn draw_continuously_for_batch(start: Option<Res<ViewStart>>, mut settings: ResMut<WinitSettings>) {
-    if start.is_some_and(|s| s.screenshot.is_some() || s.hdr.is_some()) {
-        *settings = WinitSettings::continuous();
+/// A precomputation's task wakes the window when its light is ready.
+fn wake_for_the_light(proxy: Option<Res<EventLoopProxyWrapper>>, mut commands: Commands) {
+    let Some(proxy) = proxy else { return };
+    let proxy = Mutex::new((**proxy).clone());
+    commands.insert_resource(LightWaker(Arc::new(move || {
+        // Fails only once the event loop is gone: nothing left to wake.
+        let _ = proxy.lock().map(|p| p.send_event(WinitUserEvent::WakeUp));
+    })));
+}
+
+/// The batch flow draws frame after frame, but for while only a
+/// precomputation runs: then it sleeps as a window at rest does.
+fn draw_continuously_for_batch(start: Option<Res<ViewStart>>, movers: Movers, mut settings: ResMut<WinitSettings>) {
+    if !start.is_some_and(|s| s.screenshot.is_some() || s.hdr.is_some()) {
+        return;
+    }
+    let wanted = if movers.engine.is_precomputing() && !movers.any() { WinitSettings::desktop_app() } else { WinitSettings::continuous() };
+    if settings.focused_mode != wanted.focused_mode {
+        *settings = wanted;
     }
 }
 
@@ -87,7 +109,7 @@ struct Movers<'w> {
 impl Movers<'_> {
     fn any(&self) -> bool {
         self.active.is_loading()
-            || self.engine.is_settling(&self.state)
+            || self.engine.is_relighting(&self.state)
             || self.day.0.is_running()
             || self.year.map.is_running()
             || self.annual.result.is_running()
