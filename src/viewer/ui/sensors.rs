@@ -1,4 +1,4 @@
-//! The sensors panel: the live table, the selected sensor's day and year
+//! The sensors panel: the live table room by room, the selected sensor's day and year
 //! (egui_plot: axes with units, hover values, legend, the year's colour
 //! scale), and CSV export of the table and the day.
 
@@ -9,6 +9,7 @@ use egui_plot::{Heatmap, Legend, Line, Plot, PlotPoint, PlotPoints, Points, VLin
 
 use crate::day::{DAY_STEPS, YEAR_DAYS};
 use crate::ecs::{ActiveScene, LightingState};
+use crate::light::SensorReading;
 use crate::report::csv_field;
 use crate::time::LocalDateTime;
 use crate::viewer::sensors::{DaySeries, SelectedSensor, YearMap};
@@ -77,14 +78,52 @@ fn sensor_panel(ui: &mut Ui, note: &mut Option<String>, sensors: &mut SensorPane
             *note = Some(write_export(&format!("heliodon-day-{}.csv", readings[i].name.replace('/', "-")), &csv));
         }
     });
-    egui::Grid::new("sensors").striped(true).num_columns(5).show(ui, |ui| {
+    // A grid's or a room's sensors (`<room>/<k>`) under one header with
+    // their mean, least and most: a building's thousands of sensors read
+    // room by room, and a closed room draws none of its rows. Sensors of
+    // no room, one after another, make one table.
+    let mut rows = 0..0;
+    while rows.end < readings.len() {
+        rows = rows.end..rows.end + 1;
+        let room = room_of(&readings[rows.start]);
+        while readings.get(rows.end).is_some_and(|r| room_of(r) == room) {
+            rows.end += 1;
+        }
+        match room {
+            Some(room) => {
+                let totals = readings[rows.clone()].iter().map(|r| r.total);
+                let mean = totals.clone().sum::<f64>() / rows.len() as f64;
+                let (least, most) = totals.fold((f64::INFINITY, 0.0f64), |(lo, hi), t| (lo.min(t), hi.max(t)));
+                let title = format!("{room}: {} sensors, mean {mean:.0} lx, {least:.0}–{most:.0}", rows.len());
+                egui::CollapsingHeader::new(title)
+                    .id_salt(("sensor room", rows.start))
+                    .default_open(readings.len() <= ROWS_OPEN)
+                    .show(ui, |ui| sensor_rows(ui, readings, rows.clone(), &mut sensors.selected.0));
+            }
+            None => sensor_rows(ui, readings, rows.clone(), &mut sensors.selected.0),
+        }
+    }
+}
+
+/// The room of a grid's or room's sensor (`<room>/<k>`).
+fn room_of(reading: &SensorReading) -> Option<&str> {
+    reading.name.split_once('/').map(|(room, _)| room)
+}
+
+/// A scene with more sensors than this shows its rooms' headers closed.
+const ROWS_OPEN: usize = 100;
+
+/// The table's rows `rows` of `readings`: name (click to select), total,
+/// sun, sky and indirect lux.
+fn sensor_rows(ui: &mut Ui, readings: &[SensorReading], rows: std::ops::Range<usize>, selected: &mut Option<usize>) {
+    egui::Grid::new(("sensors", rows.start)).striped(true).num_columns(5).show(ui, |ui| {
         for title in ["sensor", "total", "sun", "sky", "indirect"] {
             ui.strong(title);
         }
         ui.end_row();
-        for (i, r) in readings.iter().enumerate() {
-            if ui.selectable_label(sensors.selected.0 == Some(i), &r.name).clicked() {
-                sensors.selected.0 = Some(i);
+        for (i, r) in readings.iter().enumerate().take(rows.end).skip(rows.start) {
+            if ui.selectable_label(*selected == Some(i), &r.name).clicked() {
+                *selected = Some(i);
             }
             for value in [r.total, r.direct_sun, r.direct_sky, r.indirect] {
                 ui.monospace(format!("{value:8.0}"));
