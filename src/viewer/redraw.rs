@@ -13,7 +13,7 @@
 //! (`view --screenshot/--hdr`) draws continuously but for the same sleep.
 
 use std::collections::VecDeque;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
@@ -75,10 +75,11 @@ fn time_drawn_frames(time: Res<Time<Real>>, mut asked: MessageReader<RequestRedr
 /// A precomputation's task wakes the window when its light is ready.
 fn wake_for_the_light(proxy: Option<Res<EventLoopProxyWrapper>>, mut commands: Commands) {
     let Some(proxy) = proxy else { return };
-    let proxy = Mutex::new((**proxy).clone());
+    // A resource already, so shared across threads as it is.
+    let proxy = (**proxy).clone();
     commands.insert_resource(LightWaker(Arc::new(move || {
         // Fails only once the event loop is gone: nothing left to wake.
-        let _ = proxy.lock().map(|p| p.send_event(WinitUserEvent::WakeUp));
+        let _ = proxy.send_event(WinitUserEvent::WakeUp);
     })));
 }
 
