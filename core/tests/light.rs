@@ -357,6 +357,41 @@ fn the_cache_is_used_and_never_trusted_when_damaged() {
 }
 
 #[test]
+fn a_model_beside_another_shares_what_they_have_alike_and_equals_its_own_trace() {
+    use heliodon_core::light::cache::{CacheOutcome, precompute_cached, precompute_cached_beside};
+    let scene = load(&sideroom());
+    let settings = quick_light();
+    // The viewer's model for display: every side's rays, beside the settings' own.
+    let display = LightSettings { unseen_ray_share: 1.0, ..settings };
+    let (base, _) = precompute_cached(scene.clone(), settings, None, &|_| {}).unwrap();
+    let (alone, _) = precompute_cached(scene.clone(), display, None, &|_| {}).unwrap();
+    let sides = scene.patches.patches.len() * 2;
+    let shared = |model: &LightModel| (0..sides).filter(|&s| std::ptr::eq(model.side_gather(s), base.side_gather(s))).count();
+    let sky = sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-03-21", "10:00");
+    let expected = alone.solve(&sky, None);
+    // Traced beside the settings' model, and read from the cache beside it.
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_cache_beside");
+    let _ = std::fs::remove_dir_all(&dir);
+    for outcome_is_hit in [false, true] {
+        let (model, outcome) = precompute_cached_beside(scene.clone(), display, Some(&base), Some(&dir), &|_| {}).unwrap();
+        assert_eq!(matches!(outcome, CacheOutcome::Hit(_)), outcome_is_hit, "{outcome:?}");
+        for side in 0..sides {
+            assert_eq!(model.side_gather(side), alone.side_gather(side), "side {side}");
+        }
+        for sensor in 0..scene.sensors.len() {
+            assert_eq!(model.sensor_gather(sensor), alone.sensor_gather(sensor), "sensor {sensor}");
+        }
+        assert_eq!(model.solve(&sky, None), expected);
+        // The sides seen from the sensors keep their rays, so they are the
+        // settings' model's, held once; the others, given more rays, differ.
+        let (own, alike) = (shared(&model), (0..sides).filter(|&s| base.side_gather(s) == alone.side_gather(s)).count());
+        assert!(own > 0 && own == alike && alike < sides, "{own} of {alike} sides alike shared, {sides} sides");
+    }
+    // A model alone shares nothing.
+    assert_eq!(shared(&alone), 0);
+}
+
+#[test]
 fn open_models_and_sensors_inside_solids_are_handled() {
     // Without its ceiling the room leaks light: that is the model's truth.
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_open");

@@ -184,7 +184,7 @@ fn start_precompute(
     *state = LightingState::default();
     let display = settings.for_display(scene.patches.patches.len());
     engine.refinement = (refine.0 && display != settings).then(|| (scene.clone(), display));
-    engine.precompute = Some(precomputer.spawn(scene, settings));
+    engine.precompute = Some(precomputer.spawn(scene, settings, None));
 }
 
 /// What a precomputation needs besides its scene and settings: where it
@@ -197,15 +197,18 @@ struct Precomputer<'w> {
 
 impl Precomputer<'_> {
     /// The precomputation of `scene` with `settings` (or its cached model)
-    /// as a task, which wakes the app when its model is there to take.
-    fn spawn(&self, scene: Arc<crate::scene::Scene>, settings: light::LightSettings) -> Precompute {
+    /// as a task, which wakes the app when its model is there to take;
+    /// what it has alike with the model `beside` (the tracers, the sensors,
+    /// most patch sides of a large model) is that model's, shared.
+    fn spawn(&self, scene: Arc<crate::scene::Scene>, settings: light::LightSettings, beside: Option<Arc<LightModel>>) -> Precompute {
         let dir = self.cache_dir.0.clone();
         let waker = self.waker.as_deref().cloned();
         let result = Arc::new(Mutex::new(None));
         let slot = result.clone();
         let task = AsyncComputeTaskPool::get().spawn(async move {
             // The viewer meters exposure by tracing the model in a frame.
-            let model = cache::precompute_cached(scene, settings, dir.as_deref(), &|_| {}).map(|(model, _)| model.with_tracer());
+            let model = cache::precompute_cached_beside(scene, settings, beside.as_deref(), dir.as_deref(), &|_| {})
+                .map(|(model, _)| model.with_tracer());
             *slot.lock().expect("precomputation result lock") = Some(model);
             if let Some(LightWaker(wake)) = waker {
                 wake();
@@ -245,7 +248,7 @@ fn start_refinement(state: Res<LightingState>, precomputer: Precomputer, mut eng
         return;
     }
     if let Some((scene, settings)) = engine.refinement.take() {
-        engine.precompute = Some(precomputer.spawn(scene, settings));
+        engine.precompute = Some(precomputer.spawn(scene, settings, engine.model.clone()));
     }
 }
 

@@ -231,6 +231,7 @@ pub fn side_of(patch: u32, back: bool) -> u32 {
 }
 
 /// What a sensor sees, gathered once.
+#[derive(Clone)]
 pub(super) struct SensorGeometry {
     /// Points whose direct sun is averaged.
     pub(super) sun_points: Vec<DVec3>,
@@ -243,6 +244,14 @@ pub(super) struct SensorGeometry {
     pub(super) landings: Landings,
     /// The panels' window points it sees, per panel group, found on first use.
     pub(super) panel_views: std::sync::OnceLock<Vec<Vec<super::measured::SeenSample>>>,
+}
+
+/// Equal where traced alike (the panels' window points, found on first
+/// use, aside): what the cache holds.
+impl PartialEq for SensorGeometry {
+    fn eq(&self, other: &Self) -> bool {
+        self.sun_points == other.sun_points && self.normal == other.normal && self.gather == other.gather && self.landings == other.landings
+    }
 }
 
 impl SensorGeometry {
@@ -262,13 +271,19 @@ impl LightModel {
         settings.check()?;
         check_memory(&scene, &settings)?;
         let dark = super::solids::dark_sides(&scene);
-        Ok(Self::empty(scene, settings).gathered(&dark, progress))
+        Ok(Self::empty(scene, settings, None).gathered(&dark, None, progress))
     }
 
     /// This model, made by [`Self::empty`], with every patch side's and
     /// sensor's gather; the sides `dark` inside solids ([`super::solids`])
-    /// gather nothing.
-    pub(super) fn gathered(mut self, dark: &[bool], progress: &(dyn Fn(f64) + Sync)) -> Self {
+    /// gather nothing. Beside a model of the same scene and settings but
+    /// for the share of rays of the sides no sensor sees (the viewer's
+    /// model for display beside the settings' own), a side whose rays are
+    /// the same is that model's, shared, not traced again, and so are the
+    /// sensors where no side traced again changes whether the sun may
+    /// reach it (their landings keep such sides only): each is what a
+    /// trace would give, bit for bit.
+    pub(super) fn gathered(mut self, dark: &[bool], beside: Option<&LightModel>, progress: &(dyn Fn(f64) + Sync)) -> Self {
         let model = &mut self;
         let patches = &model.scene.patches.patches;
         let total = patches.len() * 2 + model.scene.sensors.len();
@@ -280,23 +295,47 @@ impl LightModel {
             }
         };
         let targets = model.window_targets();
+        let beside = beside.filter(|b| {
+            Arc::ptr_eq(&b.scene, &model.scene)
+                && LightSettings { unseen_ray_share: model.settings.unseen_ray_share, ..b.settings } == model.settings
+        });
         // What a sensor sees straight gets all its rays: its noise would show.
         let seen = model.seen_by_sensors();
-        let unseen_share = if model.scene.sensors.is_empty() { 1.0 } else { model.settings.unseen_ray_share };
-        model.side_gathers = par_map(model.settings.threads, patches.len() * 2, |side| {
-            let gather = match (dark[side], seen[side]) {
-                (true, _) => Gather::default(),
-                (false, true) => model.gather_patch_side(side, &targets, 1.0),
-                (false, false) => model.gather_patch_side(side, &targets, model.ray_shares[side / 2].min(unseen_share)),
+        let share = |settings: &LightSettings, side: usize| {
+            let unseen_share = if model.scene.sensors.is_empty() { 1.0 } else { settings.unseen_ray_share };
+            (!dark[side]).then(|| if seen[side] { 1.0 } else { model.ray_shares[side / 2].min(unseen_share) })
+        };
+        let nothing = Arc::new(Gather::default());
+        let gathers = par_map(model.settings.threads, patches.len() * 2, |side| {
+            let own = share(&model.settings, side);
+            let gather = match (own, beside) {
+                (_, Some(b)) if share(&b.settings, side) == own => (b.side_gathers[side].clone(), false),
+                (None, _) => (nothing.clone(), false),
+                (Some(own), beside) => {
+                    let traced = model.gather_patch_side(side, &targets, own);
+                    match beside.map(|b| &b.side_gathers[side]) {
+                        // Glass gathers nothing, whatever its rays.
+                        Some(theirs) if **theirs == traced => (theirs.clone(), true),
+                        _ => (Arc::new(traced), true),
+                    }
+                }
             };
             tick();
             gather
         });
-        let sensors = model.scene.sensors.clone();
-        model.sensors = par_map(model.settings.threads, sensors.len(), |i| {
-            let geometry = model.sensor_geometry(i, &sensors[i], &targets);
-            tick();
-            geometry
+        let sees_sky = |g: &Gather| !g.daylight_coefficients.is_empty();
+        let same_sunlit_sides = |b: &LightModel| {
+            gathers.iter().enumerate().all(|(side, (g, traced))| !traced || sees_sky(g) == sees_sky(&b.side_gathers[side]))
+        };
+        let shared_sensors = beside.filter(|b| same_sunlit_sides(b)).map(|b| b.sensors.clone());
+        model.side_gathers = gathers.into_iter().map(|(g, _)| g).collect();
+        model.sensors = shared_sensors.unwrap_or_else(|| {
+            let sensors = model.scene.sensors.clone();
+            Arc::new(par_map(model.settings.threads, sensors.len(), |i| {
+                let geometry = model.sensor_geometry(i, &sensors[i], &targets);
+                tick();
+                geometry
+            }))
         });
         self
     }

@@ -103,10 +103,10 @@ pub struct LightModel {
     /// first use, since a start from the cache traces none (a warm
     /// `sensors` run on AC20-Institute-Var-2 with one office's sensors
     /// spares 210 ms).
-    tracer: std::sync::OnceLock<Tracer>,
+    tracer: std::sync::OnceLock<Arc<Tracer>>,
     /// The model's own triangles, hits naming their scene surface: fewer
     /// than the patches' render triangles, for shadow rays toward the sun.
-    shadow_tracer: Tracer,
+    shadow_tracer: Arc<Tracer>,
     surfaces: Vec<Surface>,
     /// The windows by material and outward facing (the one grouping rule).
     pub windows: WindowGroups,
@@ -128,9 +128,10 @@ pub struct LightModel {
     /// lies ([`crate::scene::PatchSizing::ray_share`]).
     ray_shares: Vec<f64>,
     /// Per patch side (2 per patch; empty for glass, the outer side of
-    /// panels and sides inside solids, `solids`).
-    side_gathers: Vec<Gather>,
-    sensors: Vec<SensorGeometry>,
+    /// panels and sides inside solids, `solids`), shared with a model this
+    /// one refines where they are the same ([`cache::precompute_cached_beside`]).
+    side_gathers: Vec<Arc<Gather>>,
+    sensors: Arc<Vec<SensorGeometry>>,
     /// [`cache::key`] of `scene` and `settings`, found once: the cached
     /// tables made from the model key on it, and finding it finds the
     /// sides inside solids (88 ms on AC20-Institute-Var-2).
@@ -214,7 +215,7 @@ impl LightModel {
     /// for ray queries ([`Self::trace`], [`Self::sun_irradiance`]), not for
     /// lighting.
     pub fn unlit(scene: Arc<Scene>) -> Self {
-        Self::empty(scene, LightSettings::default()).with_tracer()
+        Self::empty(scene, LightSettings::default(), None).with_tracer()
     }
 
     /// This model with its patch tracer built now, not at the first ray
@@ -236,15 +237,23 @@ impl LightModel {
     }
 
     fn tracer(&self) -> &Tracer {
-        self.tracer.get_or_init(|| Tracer::new(&self.scene.patches))
+        self.tracer.get_or_init(|| Arc::new(Tracer::new(&self.scene.patches)))
     }
 
-    /// The model with its tracer and materials but nothing gathered yet.
-    fn empty(scene: Arc<Scene>, settings: LightSettings) -> Self {
-        let shadow_tracer = Tracer::over(
-            &scene.triangles.iter().map(|t| t.vertices).collect::<Vec<_>>(),
-            scene.surfaces.iter().enumerate().flat_map(|(k, s)| std::iter::repeat_n(k as u32, s.triangles.len())).collect(),
+    /// The model with its tracer and materials but nothing gathered yet;
+    /// the tracers those of `beside` where it has them and the same scene.
+    fn empty(scene: Arc<Scene>, settings: LightSettings, beside: Option<&LightModel>) -> Self {
+        let beside = beside.filter(|b| Arc::ptr_eq(&b.scene, &scene));
+        let shadow_tracer = beside.map_or_else(
+            || {
+                Arc::new(Tracer::over(
+                    &scene.triangles.iter().map(|t| t.vertices).collect::<Vec<_>>(),
+                    scene.surfaces.iter().enumerate().flat_map(|(k, s)| std::iter::repeat_n(k as u32, s.triangles.len())).collect(),
+                ))
+            },
+            |b| b.shadow_tracer.clone(),
         );
+        let tracer = beside.and_then(|b| b.tracer.get()).cloned().map_or_else(std::sync::OnceLock::new, std::sync::OnceLock::from);
         let surfaces = scene
             .materials
             .iter()
@@ -291,11 +300,11 @@ impl LightModel {
             openings,
             scene,
             settings,
-            tracer: std::sync::OnceLock::new(),
+            tracer,
             shadow_tracer,
             surfaces,
             side_gathers: Vec::new(),
-            sensors: Vec::new(),
+            sensors: Arc::default(),
             cache_key: std::sync::OnceLock::new(),
             landings_on_sides: std::sync::OnceLock::new(),
         };
@@ -372,7 +381,7 @@ impl LightModel {
             group.set_model(model.clone());
         }
         // Which data cells the sensors see the windows in is the model's.
-        self.sensors.iter_mut().for_each(|s| s.panel_views = std::sync::OnceLock::new());
+        Arc::make_mut(&mut self.sensors).iter_mut().for_each(|s| s.panel_views = std::sync::OnceLock::new());
     }
 
     /// The back reflectance of panel material `material`'s windows, as the

@@ -215,7 +215,7 @@ impl Relight<'_> {
             .scene
             .sensors
             .iter()
-            .zip(&model.sensors)
+            .zip(model.sensors.iter())
             .zip(&self.sensors)
             .map(|((sensor, geometry), direct)| {
                 let rgb = form_factor_product(direct.sun_bounce, &geometry.gather.form_factors, &without_sun);
