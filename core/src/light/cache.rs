@@ -721,7 +721,7 @@ impl LightModel {
     /// This model (read from the cache) with what it has alike with
     /// `beside` held once: its sides and sensors equal to `beside`'s.
     fn sharing(mut self, beside: Option<&LightModel>) -> Self {
-        let Some(beside) = beside.filter(|b| Arc::ptr_eq(&b.scene, &self.scene) && b.side_gathers.len() == self.side_gathers.len()) else {
+        let Some(beside) = beside.filter(|b| Arc::ptr_eq(&b.scene, &self.scene)) else {
             return self;
         };
         for (own, theirs) in self.side_gathers.iter_mut().zip(&beside.side_gathers) {

@@ -323,12 +323,12 @@ impl LightModel {
             tick();
             gather
         });
-        let sees_sky = |g: &Gather| !g.daylight_coefficients.is_empty();
+        let traced: Vec<bool>;
+        (model.side_gathers, traced) = gathers.into_iter().unzip();
         let same_sunlit_sides = |b: &LightModel| {
-            gathers.iter().enumerate().all(|(side, (g, traced))| !traced || sees_sky(g) == sees_sky(&b.side_gathers[side]))
+            (0..traced.len() as u32).all(|side| !traced[side as usize] || model.may_be_sunlit(side) == b.may_be_sunlit(side))
         };
         let shared_sensors = beside.filter(|b| same_sunlit_sides(b)).map(|b| b.sensors.clone());
-        model.side_gathers = gathers.into_iter().map(|(g, _)| g).collect();
         model.sensors = shared_sensors.unwrap_or_else(|| {
             let sensors = model.scene.sensors.clone();
             Arc::new(par_map(model.settings.threads, sensors.len(), |i| {
