@@ -350,6 +350,29 @@ fn the_cache_is_used_and_never_trusted_when_damaged() {
     std::fs::write(work.join("model.obj"), moved).unwrap();
     let (_, outcome) = precompute_cached(load(&work.join("scene.toml")), settings, Some(&dir), &|_| {}).unwrap();
     assert!(matches!(&outcome, CacheOutcome::Stored(p) if *p != path), "{outcome:?}");
+    // The same points, every face with vertices of its own: which shells
+    // close, and with them which sides are dark inside solids, follows the
+    // file's vertices, so the key does.
+    let positions: Vec<&str> = obj.lines().filter(|l| l.starts_with("v ")).collect();
+    let mut apart = String::new();
+    let mut written = 0;
+    for line in obj.lines().filter(|l| !l.starts_with("v ")) {
+        let Some(corners) = line.strip_prefix("f ") else {
+            apart += &format!("{line}\n");
+            continue;
+        };
+        let corners: Vec<usize> = corners.split_whitespace().map(|c| c.parse().unwrap()).collect();
+        for &corner in &corners {
+            apart += &format!("{}\n", positions[corner - 1]);
+        }
+        apart += &format!("f {}\n", (written + 1..=written + corners.len()).map(|k| k.to_string()).collect::<Vec<_>>().join(" "));
+        written += corners.len();
+    }
+    std::fs::write(work.join("model.obj"), apart).unwrap();
+    let unwelded = load(&work.join("scene.toml"));
+    assert_eq!(unwelded.patches, scene.patches);
+    let (_, outcome) = precompute_cached(unwelded, settings, Some(&dir), &|_| {}).unwrap();
+    assert!(matches!(&outcome, CacheOutcome::Stored(p) if *p != path), "{outcome:?}");
     let (_, outcome) = precompute_cached(scene.clone(), LightSettings { rays_per_patch: 65, ..settings }, Some(&dir), &|_| {}).unwrap();
     assert!(matches!(outcome, CacheOutcome::Stored(_)), "{outcome:?}");
     let (_, outcome) = precompute_cached(scene, settings, None, &|_| {}).unwrap();

@@ -75,6 +75,14 @@ impl Fnv {
     pub fn f64(&mut self, v: f64) -> &mut Self {
         self.u64(v.to_bits())
     }
+
+    /// `values`, each by its bits.
+    pub fn f32s(&mut self, values: &[f32]) -> &mut Self {
+        for v in values {
+            self.bytes(&v.to_bits().to_le_bytes());
+        }
+        self
+    }
 }
 
 /// The key of a scene's precomputation: what the gathers depend on, and
@@ -82,30 +90,39 @@ impl Fnv {
 /// and patch sizes), which materials pass light and how, which surface has
 /// which, the sensors' placement, and the settings that shape the result;
 /// not comments, names, reflectances, the site or the thread count.
+///
+/// The sides left dark inside solids follow from what is hashed here (the
+/// model's triangles with their file's vertices, its surfaces and
+/// clusters, which materials pass light), so a warm start need not find
+/// them: a change to how they are found changes [`FORMAT`].
 pub fn key(scene: &Scene, settings: &LightSettings) -> u64 {
-    key_with_dark_sides(scene, settings, &super::solids::dark_sides(scene))
-}
-
-/// [`key`] with the sides inside solids found already.
-fn key_with_dark_sides(scene: &Scene, settings: &LightSettings, dark: &[bool]) -> u64 {
     let mut hash = Fnv::new();
     hash.bytes(MAGIC).u64(u64::from(FORMAT)).bytes(env!("CARGO_PKG_VERSION").as_bytes());
-    let mut floats = |values: &[f32]| {
-        for v in values {
-            hash.bytes(&v.to_bits().to_le_bytes());
-        }
-    };
     for triangle in &scene.patches.triangles {
-        floats(&triangle.map(|v| v.to_array()).concat());
+        hash.f32s(&triangle.map(|v| v.to_array()).concat());
     }
     // How many rays each patch traces follows the focus.
-    floats(&scene.patch_sizing.as_floats());
+    hash.f32s(&scene.patch_sizing.as_floats());
     for sensor in &scene.sensors {
-        floats(&[sensor.position.to_array(), sensor.normal.to_array(), sensor.axes[0].to_array(), sensor.axes[1].to_array()].concat());
-        floats(&[sensor.size.unwrap_or(-1.0)]);
+        hash.f32s(&[sensor.position.to_array(), sensor.normal.to_array(), sensor.axes[0].to_array(), sensor.axes[1].to_array()].concat());
+        hash.f32s(&[sensor.size.unwrap_or(-1.0)]);
+    }
+    // Which shells close (the sides dark inside solids) depends on the
+    // model's triangles and on its file's vertices.
+    for triangle in &scene.triangles {
+        hash.f32s(&triangle.vertices.map(|v| v.to_array()).concat());
+        for vertex in triangle.file_vertices {
+            hash.u64(u64::from(vertex));
+        }
     }
     for patch in &scene.patches.patches {
         hash.u64(u64::from(patch.triangles.end)).u64(u64::from(patch.surface)).u64(u64::from(patch.material));
+    }
+    for (patch, surfaces) in &scene.patches.clusters {
+        hash.u64(u64::from(*patch));
+        for &surface in surfaces {
+            hash.u64(u64::from(surface));
+        }
     }
     // Materials edited at run time: what the gathers depend on (which
     // materials pass light, and glass transmittance; not reflectances), and
@@ -119,12 +136,7 @@ fn key_with_dark_sides(scene: &Scene, settings: &LightSettings, dark: &[bool]) -
     }
     // Surfaces given materials of their own at run time.
     for surface in &scene.surfaces {
-        hash.u64(u64::from(surface.material));
-    }
-    // The sides left dark inside solids (which shells close depends on the
-    // file's vertices as well as on the points).
-    for (side, _) in dark.iter().enumerate().filter(|(_, dark)| **dark) {
-        hash.u64(side as u64);
+        hash.u64(u64::from(surface.material)).u64(u64::from(surface.triangles.end));
     }
     hash.u64(settings.rays_per_patch as u64)
         .u64(settings.window_rays_per_patch as u64)
@@ -166,21 +178,23 @@ pub fn precompute_cached_beside(
 ) -> Result<(LightModel, CacheOutcome), String> {
     settings.check()?;
     // Every start needs the model (its shadow tracer, windows, openings)
-    // and the key, so they are made side by side; the sides inside solids
-    // the key holds are those a gather skips, found once.
+    // and the key, so they are made side by side; so are the sides inside
+    // solids, which only a gather needs, where no cache file is there to
+    // read.
     let (empty, (key, dark)) = par_join(
         settings.threads,
         || LightModel::empty(scene.clone(), settings, beside),
         || {
-            let dark = super::solids::dark_sides(&scene);
-            (key_with_dark_sides(&scene, &settings, &dark), dark)
+            let key = key(&scene, &settings);
+            let cached = dir.is_some_and(|dir| file_path(dir, &file_name(key)).exists());
+            (key, (!cached).then(|| super::solids::dark_sides(&scene)))
         },
     );
     let empty = std::cell::Cell::new(Some(empty));
     let take = || empty.take().expect("the model is loaded or gathered, once");
     let (model, outcome) = through_cache(
         dir,
-        &format!("{key:016x}"),
+        &file_name(key),
         key,
         |payload| {
             let (side_gathers, sensors) = LightModel::read_payload(&scene, &settings, payload)?;
@@ -188,12 +202,18 @@ pub fn precompute_cached_beside(
         },
         || {
             super::gather::check_memory(&scene, &settings)?;
+            let dark = dark.unwrap_or_else(|| super::solids::dark_sides(&scene));
             Ok(take().gathered(&dark, beside, progress))
         },
         LightModel::payload,
     )?;
     model.cache_key.get_or_init(|| key);
     Ok((model, outcome))
+}
+
+/// The name of the cache file of the precomputation keyed `key`.
+fn file_name(key: u64) -> String {
+    format!("{key:016x}")
 }
 
 /// Where the cache file `name` lives in `dir`.

@@ -198,7 +198,8 @@ pub fn triangles(
     let mut degenerate = 0usize;
     // Faces written twice (same corners, same material) count once: copies
     // would weigh on every ray and pass for nothing.
-    let mut seen: std::collections::HashSet<([[u32; 3]; 3], u32)> = std::collections::HashSet::new();
+    let mut seen: rustc_hash::FxHashSet<([[u32; 3]; 3], u32)> = rustc_hash::FxHashSet::default();
+    seen.reserve(model.meshes.iter().map(|m| m.mesh.indices.len() / 3).sum());
     let mut duplicated = 0usize;
     // tobj numbers each mesh's vertices from 0: numbered on across meshes.
     let mut first_vertex = 0u32;

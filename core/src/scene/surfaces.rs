@@ -1,9 +1,8 @@
 //! Surfaces: the model's triangles grouped into connected planar pieces of one
 //! material (a wall, a desk top, a window pane), and the windows among them.
 
-use std::collections::HashMap;
-
 use glam::Vec3;
+use rustc_hash::FxHashMap;
 
 use super::material::Material;
 use super::{Surface, Triangle, Window};
@@ -21,22 +20,28 @@ const COPLANAR_COS: f32 = 0.99966;
 pub fn group(triangles: Vec<Triangle>) -> (Vec<Triangle>, Vec<Surface>) {
     let normals: Vec<Vec3> = triangles.iter().map(Triangle::normal).collect();
     let mut sets = DisjointSets::new(triangles.len());
-    let mut edges: HashMap<([i64; 3], [i64; 3]), Vec<u32>> = HashMap::new();
+    // The welded corners numbered, each edge the pair of its corners'
+    // numbers beside its triangle, sorted: the triangles on one edge lie
+    // together, in their order.
+    let mut corner_numbers: FxHashMap<[i64; 3], u32> = FxHashMap::default();
+    let mut edges: Vec<(u64, u32)> = Vec::with_capacity(triangles.len() * 3);
     for (t, triangle) in triangles.iter().enumerate() {
-        let keys = triangle.vertices.map(weld_key);
-        for (a, b) in [(keys[0], keys[1]), (keys[1], keys[2]), (keys[2], keys[0])] {
-            let edge = if a <= b { (a, b) } else { (b, a) };
-            edges.entry(edge).or_default().push(t as u32);
+        let corners = triangle.vertices.map(|v| {
+            let next = corner_numbers.len() as u32;
+            *corner_numbers.entry(weld_key(v)).or_insert(next)
+        });
+        for (a, b) in [(corners[0], corners[1]), (corners[1], corners[2]), (corners[2], corners[0])] {
+            edges.push(((u64::from(a.min(b)) << 32) | u64::from(a.max(b)), t as u32));
         }
     }
-    // HashMap order does not matter: unions give the same partition in any
-    // order. Each triangle on an edge joins every earlier *representative*
-    // it fits (same material, coplanar), or becomes one: near-linear even
+    edges.sort_unstable();
+    // Each triangle on an edge joins every earlier *representative* it
+    // fits (same material, coplanar), or becomes one: near-linear even
     // when thousands of copies of a face share its edges.
     let mut representatives: Vec<u32> = Vec::new();
-    for sharing in edges.values() {
+    for sharing in edges.chunk_by(|a, b| a.0 == b.0) {
         representatives.clear();
-        for &t in sharing {
+        for &(_, t) in sharing {
             let fits = |r: &u32| {
                 triangles[*r as usize].material == triangles[t as usize].material
                     && normals[*r as usize].dot(normals[t as usize]) >= COPLANAR_COS
@@ -51,15 +56,16 @@ pub fn group(triangles: Vec<Triangle>) -> (Vec<Triangle>, Vec<Surface>) {
             }
         }
     }
-    let mut surface_of_root: HashMap<u32, u32> = HashMap::new();
+    // Surfaces numbered in the order of their first triangle.
+    let mut surface_of_root = vec![u32::MAX; triangles.len()];
     let mut members: Vec<Vec<u32>> = Vec::new();
     for t in 0..triangles.len() as u32 {
-        let root = sets.find(t);
-        let surface = *surface_of_root.entry(root).or_insert_with(|| {
+        let root = sets.find(t) as usize;
+        if surface_of_root[root] == u32::MAX {
+            surface_of_root[root] = members.len() as u32;
             members.push(Vec::new());
-            members.len() as u32 - 1
-        });
-        members[surface as usize].push(t);
+        }
+        members[surface_of_root[root] as usize].push(t);
     }
     let mut ordered = Vec::with_capacity(triangles.len());
     let mut surfaces = Vec::with_capacity(members.len());
