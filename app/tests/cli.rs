@@ -387,7 +387,7 @@ fn export_radiance_writes_the_same_model_and_sky() {
     let expected: usize = scene.sensors.iter().map(|s| if s.size.is_some() { 16 } else { 1 }).sum();
     assert_eq!(points.lines().count(), expected);
     assert_eq!(index.lines().count(), scene.sensors.len());
-    assert!(std::fs::read_to_string(out.join("run.sh")).unwrap().contains("rtrace -h -I -ab 16"));
+    assert!(std::fs::read_to_string(out.join("run.sh")).unwrap().contains("rtrace -h -I -ab 64"));
     // The floor sensor lies on the floor: it is exported lifted 1 cm, as heliodon reads it.
     let floor = index.lines().position(|l| l.starts_with("floor-centre ")).unwrap();
     let first_point: usize = index.lines().take(floor).map(|l| l.split(' ').nth(1).unwrap().parse::<usize>().unwrap()).sum();
