@@ -133,8 +133,8 @@ pub struct LightModel {
     side_gathers: Vec<Arc<Gather>>,
     sensors: Arc<Vec<SensorGeometry>>,
     /// [`cache::key`] of `scene` and `settings`, found once: the cached
-    /// tables made from the model key on it, and finding it finds the
-    /// sides inside solids (88 ms on AC20-Institute-Var-2).
+    /// tables made from the model key on it, and finding it hashes every
+    /// triangle of the model and of its patches.
     cache_key: std::sync::OnceLock<u64>,
     /// Per patch side, how many of the sensors' rays land on it: found on
     /// first use (a pass over every landing), since a relight and every
