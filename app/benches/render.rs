@@ -37,7 +37,7 @@ use heliodon::bevy::render::render_resource::PollType;
 use heliodon::bevy::render::renderer::RenderDevice;
 use heliodon::ecs::{ActiveScene, SunSky};
 use heliodon::render::RayModel;
-use heliodon::render::offscreen::{OffscreenRequest, frame_ready, offscreen_app};
+use heliodon::render::offscreen::{AwaitsLight, OffscreenRequest, frame_ready, offscreen_app};
 use heliodon::render::sun_pass::{SunPassFrame, SunPassInput};
 use heliodon::render::{PhysicalUnits, RenderMode, RenderSettings, framing};
 use heliodon::sky::SkySpec;
@@ -147,9 +147,12 @@ fn ready_app(scene: PathBuf, mode: RenderMode) -> (App, String) {
     }
     // The viewer draws one view; the offscreen app has a second camera
     // writing physical values beside the picture, which the frame time leaves out.
-    let mut physical = app.world_mut().query_filtered::<&mut Camera, With<PhysicalUnits>>();
-    for mut camera in physical.iter_mut(app.world_mut()) {
-        camera.is_active = false;
+    // Taken out of the job's waiting cameras, so it stays off.
+    let mut physical = app.world_mut().query_filtered::<Entity, With<PhysicalUnits>>();
+    for entity in physical.iter(app.world()).collect::<Vec<_>>() {
+        let mut camera = app.world_mut().entity_mut(entity);
+        camera.remove::<AwaitsLight>();
+        camera.get_mut::<Camera>().expect("the physical camera is a camera").is_active = false;
     }
     let counts = match &app.world().resource::<SunPassInput>().0 {
         Some(frame) => format!(

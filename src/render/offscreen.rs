@@ -242,13 +242,20 @@ fn spawn_cameras(
         Transform::from_translation(view.eye).looking_at(view.target, Vec3::Z),
     );
     // Both draw once what they show has arrived (`count_ready_frames`).
-    let waiting = |order| Camera { order, is_active: false, ..default() };
+    let waiting = |order| (Camera { order, is_active: false, ..default() }, AwaitsLight);
     commands.spawn((picture_camera(), waiting(0), RenderTarget::Image(picture.clone().into()), placement.clone()));
     commands
         .spawn((hybrid_camera(), waiting(1), PhysicalUnits, RenderTarget::Image(physical.clone().into()), placement))
         .insert((Tonemapping::None, unit_exposure()));
     job.targets = Some([picture, physical]);
 }
+
+/// An offscreen camera that draws only while what the mode shows has
+/// arrived (`count_ready_frames` switches it). One taken out of the job
+/// (the render bench's physical camera, which a viewer does not draw) keeps
+/// the state it is given.
+#[derive(Component)]
+pub struct AwaitsLight;
 
 /// Whether what the mode shows has arrived: the converged light, or for
 /// direct sun alone, the sun pass's frame.
@@ -283,7 +290,7 @@ fn watch_pipelines(cache: Res<PipelineCache>, failed: Res<PipelineFailed>) {
 /// AC20-Institute-Var-2) and take its cores from the light engine.
 fn count_ready_frames(
     mut job: ResMut<Job>,
-    mut cameras: Query<&mut Camera>,
+    mut cameras: Query<&mut Camera, With<AwaitsLight>>,
     lighting: Option<Res<LightingState>>,
     sun_pass: Res<SunPassInput>,
     sun_sky: Option<Res<SunSky>>,
