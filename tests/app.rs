@@ -17,7 +17,7 @@ use heliodon::light::LightModel;
 use heliodon::panel::PanelCatalog;
 use heliodon::render::offscreen::{self, OffscreenRequest};
 use heliodon::render::reference::{self, SunComparison};
-use heliodon::render::{RenderMode, RenderSettings, overview};
+use heliodon::render::{PhysicalUnits, RenderMode, RenderSettings, overview};
 use heliodon::scene::{Viewpoint, load_scene};
 use heliodon::sky::{Sky, SkySpec};
 use heliodon::sun::solar_position;
@@ -168,6 +168,50 @@ fn render_smoke_test_draws_the_model() {
     levels.sort_unstable();
     levels.dedup();
     assert!(levels.len() >= 4, "shades {levels:?}");
+}
+
+/// The offscreen job switches on, once its light has arrived, only the
+/// cameras waiting for it (`AwaitsLight`): one taken out of them keeps the
+/// state it is given. The render bench draws the viewer's one view so; when
+/// the job switched every camera, its frames drew both and took twice as long.
+#[test]
+fn the_offscreen_job_switches_only_its_waiting_cameras() {
+    let request = OffscreenRequest {
+        scene: heliodon::bundled_scene("test_room"),
+        view: None,
+        width: 32,
+        height: 24,
+        when: None,
+        sky: None,
+        settings: RenderSettings { mode: RenderMode::Sun, ..Default::default() },
+        light: Default::default(),
+        panels: Default::default(),
+    };
+    let mut app = offscreen::offscreen_app(&request);
+    app.finish();
+    app.cleanup();
+    let start = Instant::now();
+    while !offscreen::frame_ready(&app) {
+        assert!(start.elapsed() < Duration::from_secs(120), "not ready after 120 s");
+        app.update();
+    }
+    let mut cameras = app.world_mut().query_filtered::<(Entity, Has<PhysicalUnits>), With<Camera>>();
+    let cameras: Vec<(Entity, bool)> = cameras.iter(app.world()).collect();
+    assert_eq!(cameras.len(), 2, "a picture and a physical camera");
+    let active = |app: &App, entity: Entity| app.world().get::<Camera>(entity).expect("a camera").is_active;
+    for &(entity, _) in &cameras {
+        assert!(active(&app, entity), "both draw once the light is there");
+    }
+    let (physical, _) = *cameras.iter().find(|c| c.1).expect("the physical camera");
+    let mut taken_out = app.world_mut().entity_mut(physical);
+    taken_out.remove::<offscreen::AwaitsLight>();
+    taken_out.get_mut::<Camera>().expect("a camera").is_active = false;
+    for _ in 0..3 {
+        app.update();
+    }
+    for &(entity, is_physical) in &cameras {
+        assert_eq!(active(&app, entity), !is_physical, "the picture camera draws on, the one taken out stays off");
+    }
 }
 
 /// Edges are anti-aliased after tone mapping (SMAA), the sun pass left
