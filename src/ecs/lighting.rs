@@ -19,7 +19,7 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy::tasks::{AsyncComputeTaskPool, Task};
 
-use super::{ActiveScene, HeliodonSystems, LightChanged, SceneSpawned, SunSky};
+use super::{ActiveScene, HeliodonSystems, LightChanged, RayModel, SceneSpawned, SunSky};
 use crate::light::{self, LightModel, Lighting, cache};
 
 pub struct LightingPlugin;
@@ -163,8 +163,10 @@ pub struct LightingFailed {
     pub message: String,
 }
 
+#[allow(clippy::too_many_arguments)]
 fn start_precompute(
     mut spawned: MessageReader<SceneSpawned>,
+    ray_model: Option<Res<RayModel>>,
     active: Res<ActiveScene>,
     settings: Res<LightSettings>,
     refine: Res<RefineForDisplay>,
@@ -184,7 +186,9 @@ fn start_precompute(
     *state = LightingState::default();
     let display = settings.for_display(scene.patches.patches.len());
     engine.refinement = (refine.0 && display != settings).then(|| (scene.clone(), display));
-    engine.precompute = Some(precomputer.spawn(scene, settings, None));
+    // The scene's ray-query model lends its tracers.
+    let ray_model = ray_model.map(|m| m.0.clone()).filter(|m| Arc::ptr_eq(&m.scene, &scene));
+    engine.precompute = Some(precomputer.spawn(scene, settings, ray_model));
 }
 
 /// What a precomputation needs besides its scene and settings: where it

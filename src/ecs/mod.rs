@@ -17,8 +17,8 @@ pub use lighting::{
 };
 pub use scene_asset::{PanelRegistry, RegisterPanel, SceneAsset, SceneLoader, describe_load_failure, scene_asset_path};
 pub use scene_plugin::{
-    ActiveScene, EditMaterial, GiveOwnMaterial, MaterialEditRejected, MaterialOf, OpenScene, SceneLoadFailed, SceneMaterial, ScenePlugin,
-    SceneRoot, SceneSensor, SceneSpawned, SceneSurface, SceneWindow, Site,
+    ActiveScene, EditMaterial, GiveOwnMaterial, MaterialEditRejected, MaterialOf, OpenScene, RayModel, SceneLoadFailed, SceneMaterial,
+    ScenePlugin, SceneRoot, SceneSensor, SceneSpawned, SceneSurface, SceneWindow, Site,
 };
 pub use sun_sky::{LightChanged, SkyChoice, SkyRejected, SkySubdivision, SolarTime, SunSky, SunSkyPlugin};
 

@@ -25,7 +25,7 @@ use bevy::render::renderer::{RenderAdapterInfo, RenderDevice};
 use bevy::render::view::Msaa;
 use bevy::render::{Render, RenderApp, RenderSystems};
 
-use crate::ecs::{ActiveScene, HeliodonSystems, LightEngine, LightingState, SunSky};
+use crate::ecs::{ActiveScene, HeliodonSystems, LightEngine, LightingState, RayModel, SunSky};
 use crate::light::{Channels, LightModel, side_of};
 use crate::scene::{DEFAULT_FOV, MaterialKind, Scene, Viewpoint};
 use sun_pass::{SunPassFrame, SunPassInput, SunPassPlugin, SunPassSurfaces, SunPassView};
@@ -233,41 +233,42 @@ pub type PictureCamera = (With<SunPassView>, Without<PhysicalUnits>);
 #[derive(Component, Clone, Copy, Default)]
 pub struct PhysicalUnits;
 
-/// The sun pass's surfaces and ray-query model of a scene (by address).
-type PerScene = (usize, Arc<SunPassSurfaces>, Arc<LightModel>);
+/// The sun pass's surfaces of a scene (by address).
+type PerScene = (usize, Arc<SunPassSurfaces>);
 
-/// The active scene's ray-query model (no light gathered): its panel
-/// windows and their lobes, for the sun pass and the viewer's lobe arrows.
-#[derive(Resource, Clone)]
-pub struct RayModel(pub Arc<LightModel>);
-
-/// Rebuilds what the sun pass draws when the scene, sun or mode change.
+/// Rebuilds what the sun pass draws when the scene, its ray-query model
+/// ([`RayModel`], made with the scene's precomputation), the sun or the
+/// mode change.
 fn update_sun_pass(
     active: Res<ActiveScene>,
+    ray_model: Option<Res<RayModel>>,
     sun_sky: Option<Res<SunSky>>,
     settings: Res<RenderSettings>,
     mut input: ResMut<SunPassInput>,
-    mut commands: Commands,
     mut per_scene: Local<Option<PerScene>>,
     mut generation: Local<u64>,
 ) {
-    let scene_changed = active.is_changed();
-    if !scene_changed && !settings.is_changed() && !sun_sky.as_ref().is_some_and(|s| s.is_changed()) {
+    let changed = active.is_changed() || ray_model.as_ref().is_some_and(|m| m.is_changed());
+    if !changed && !settings.is_changed() && !sun_sky.as_ref().is_some_and(|s| s.is_changed()) {
         return;
     }
     let Some(scene) = &active.scene else {
         input.0 = None;
         return;
     };
-    // The sun pass's surfaces and a ray-query model (panel windows and
-    // their lobes) are made once per scene.
+    // Panel windows and their lobes come from the scene's own ray-query
+    // model; until it is there, nothing is drawn.
+    let Some(model) = ray_model.map(|m| m.0.clone()).filter(|m| Arc::ptr_eq(&m.scene, scene)) else {
+        input.0 = None;
+        return;
+    };
+    // The sun pass's surfaces are made once per scene.
     let scene_id = Arc::as_ptr(scene) as usize;
-    let (surfaces, model) = match &*per_scene {
-        Some((id, surfaces, model)) if *id == scene_id => (surfaces.clone(), model.clone()),
+    let surfaces = match &*per_scene {
+        Some((id, surfaces)) if *id == scene_id => surfaces.clone(),
         _ => {
-            let made = (Arc::new(SunPassSurfaces::new(scene)), Arc::new(LightModel::unlit(scene.clone())));
-            *per_scene = Some((scene_id, made.0.clone(), made.1.clone()));
-            commands.insert_resource(RayModel(made.1.clone()));
+            let made = Arc::new(SunPassSurfaces::new(scene));
+            *per_scene = Some((scene_id, made.clone()));
             made
         }
     };

@@ -268,7 +268,7 @@ pub struct PanelSurface(u32);
 /// their lobes bright where the eye looks against one; the diffusely
 /// transmitted sun everywhere.
 pub(super) fn update_panel_looks(
-    ray_model: Option<Res<super::RayModel>>,
+    ray_model: Option<Res<crate::ecs::RayModel>>,
     sun_sky: Option<Res<SunSky>>,
     settings: Res<RenderSettings>,
     panels: Query<(&PanelSurface, &MeshMaterial3d<LightingMaterial>)>,

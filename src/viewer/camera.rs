@@ -117,7 +117,7 @@ pub fn navigate(
     active: Res<ActiveScene>,
     focus: Option<Res<PanelFocus>>,
     control: Option<Res<CameraControl>>,
-    ray_model: Option<Res<crate::render::RayModel>>,
+    ray_model: Option<Res<crate::ecs::RayModel>>,
     time: Res<Time>,
     mut cameras: Query<(&mut CadCamera, &mut Transform, &Camera, &GlobalTransform, &Projection)>,
     mut drag_in_view: Local<bool>,

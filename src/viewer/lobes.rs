@@ -7,8 +7,8 @@ use bevy::prelude::*;
 
 use super::focus::PanelFocus;
 use super::schedule::ViewerSystems;
+use crate::ecs::RayModel;
 use crate::ecs::{ActiveScene, SunSky};
-use crate::render::RayModel;
 
 /// `L` and the lobe arrows.
 pub struct LobesPlugin;

@@ -134,7 +134,7 @@ pub fn run(scene: PathBuf, panels: &crate::panel::PanelCatalog, start: Option<Vi
 fn frame_new_scene(
     mut spawned: MessageReader<SceneSpawned>,
     active: Res<ActiveScene>,
-    ray_model: Option<Res<crate::render::RayModel>>,
+    ray_model: Option<Res<crate::ecs::RayModel>>,
     mut pending: Local<bool>,
     mut cameras: Query<(&mut CadCamera, &mut Projection)>,
 ) {

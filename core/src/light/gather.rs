@@ -295,8 +295,10 @@ impl LightModel {
             }
         };
         let targets = model.window_targets();
+        // A model beside that gathered nothing (`unlit`) lends its tracers only.
         let beside = beside.filter(|b| {
             Arc::ptr_eq(&b.scene, &model.scene)
+                && b.side_gathers.len() == patches.len() * 2
                 && LightSettings { unseen_ray_share: model.settings.unseen_ray_share, ..b.settings } == model.settings
         });
         // What a sensor sees straight gets all its rays: its noise would show.

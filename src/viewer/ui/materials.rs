@@ -13,10 +13,10 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy_egui::egui::{self, Ui};
 
+use crate::ecs::RayModel;
 use crate::ecs::{ActiveScene, EditMaterial, GiveOwnMaterial, MaterialEditRejected, PanelRegistry};
 use crate::light::WindowGroups;
 use crate::panel::{Key, KeyKind, PanelCatalog, Parameters, default_values};
-use crate::render::RayModel;
 use crate::scene::{MaterialKind, Rgb, Scene};
 use crate::viewer::widgets::{bounded, clamp_noted};
 
