@@ -1,7 +1,8 @@
 //! [`ScenePlugin`]: opens scene files ([`OpenScene`]), and once loaded
 //! replaces the scene's entities: one per material, surface, window and
-//! sensor, under one [`SceneRoot`], and the [`Site`] resource. Materials
-//! are edited at run time ([`EditMaterial`], [`GiveOwnMaterial`]).
+//! sensor, under one [`SceneRoot`], the [`Site`] resource and the scene's
+//! ray-query model ([`RayModel`]). Materials are edited at run time
+//! ([`EditMaterial`], [`GiveOwnMaterial`]).
 
 use std::ops::{Deref, Range};
 use std::path::PathBuf;

@@ -237,8 +237,7 @@ pub struct PhysicalUnits;
 type PerScene = (usize, Arc<SunPassSurfaces>);
 
 /// Rebuilds what the sun pass draws when the scene, its ray-query model
-/// ([`RayModel`], made with the scene's precomputation), the sun or the
-/// mode change.
+/// ([`RayModel`], made when the scene spawns), the sun or the mode change.
 fn update_sun_pass(
     active: Res<ActiveScene>,
     ray_model: Option<Res<RayModel>>,

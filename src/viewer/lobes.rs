@@ -7,8 +7,7 @@ use bevy::prelude::*;
 
 use super::focus::PanelFocus;
 use super::schedule::ViewerSystems;
-use crate::ecs::RayModel;
-use crate::ecs::{ActiveScene, SunSky};
+use crate::ecs::{ActiveScene, RayModel, SunSky};
 
 /// `L` and the lobe arrows.
 pub struct LobesPlugin;

@@ -13,8 +13,7 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy_egui::egui::{self, Ui};
 
-use crate::ecs::RayModel;
-use crate::ecs::{ActiveScene, EditMaterial, GiveOwnMaterial, MaterialEditRejected, PanelRegistry};
+use crate::ecs::{ActiveScene, EditMaterial, GiveOwnMaterial, MaterialEditRejected, PanelRegistry, RayModel};
 use crate::light::WindowGroups;
 use crate::panel::{Key, KeyKind, PanelCatalog, Parameters, default_values};
 use crate::scene::{MaterialKind, Rgb, Scene};
