@@ -26,8 +26,8 @@ use bevy::winit::WinitPlugin;
 use super::sun_pass::SunPassInput;
 use super::{HeliodonRenderPlugin, PhysicalUnits, RenderMode, RenderSettings, hybrid_camera, initial_view, picture_camera};
 use crate::ecs::{
-    ActiveScene, HeliodonPlugins, LightingFailed, LightingPlugin, LightingState, OpenScene, RegisterPanel, SceneLoadFailed, SceneSpawned,
-    SkyChoice, SolarTime, SunSky,
+    ActiveScene, HeliodonPlugins, LightingFailed, LightingPlugin, LightingState, OpenScene, RayModel, RegisterPanel, SceneLoadFailed,
+    SceneSpawned, SkyChoice, SolarTime, SunSky,
 };
 use crate::scene::Viewpoint;
 use crate::sky::{LUMINOUS_EFFICACY, SkySpec};
@@ -215,9 +215,12 @@ pub fn render(request: OffscreenRequest) -> Result<RenderedImage, String> {
 }
 
 /// The picture's camera and, beside it, one with the same view writing
-/// physical values into a float image.
+/// physical values into a float image. The automatic first view traces the
+/// scene's ray-query model ([`RayModel`], made as the scene spawned).
+#[allow(clippy::too_many_arguments)]
 fn spawn_cameras(
     mut commands: Commands,
+    ray_model: Option<Res<RayModel>>,
     mut spawned: MessageReader<SceneSpawned>,
     mut failed: MessageReader<SceneLoadFailed>,
     mut light_failed: Option<MessageReader<LightingFailed>>,
@@ -233,7 +236,8 @@ fn spawn_cameras(
         return;
     }
     let Some(scene) = &active.scene else { return };
-    let view = job.request.view.clone().unwrap_or_else(|| initial_view(scene, Some(&crate::light::LightModel::unlit(scene.clone()))));
+    let model = ray_model.as_ref().map(|m| &*m.0).filter(|m| Arc::ptr_eq(&m.scene, scene));
+    let view = job.request.view.clone().unwrap_or_else(|| initial_view(scene, model));
     let (width, height) = (job.request.width, job.request.height);
     let picture = images.add(Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None));
     let physical = images.add(Image::new_target_texture(width, height, TextureFormat::Rgba32Float, None));
