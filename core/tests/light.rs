@@ -187,6 +187,25 @@ fn results_do_not_depend_on_the_thread_count() {
     assert_eq!(one, three);
 }
 
+/// Another seed is another Monte Carlo sample of the same light: every
+/// sensor's reading moves (its rays are others, and so are the patches'),
+/// the room's mean only by the noise of these few rays, and the light cache
+/// keeps the samples apart.
+#[test]
+fn another_seed_is_another_sample_of_the_same_light() {
+    let scene = load(&heliodon_core::bundled_scene("test_room"));
+    let sky = sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "10:00");
+    let settings = |seed| LightSettings { seed, ..quick_light() };
+    let read = |seed| LightModel::precompute(scene.clone(), settings(seed)).unwrap().solve(&sky, None).sensors;
+    let (first, second) = (read(0), read(1));
+    assert!(first.iter().zip(&second).all(|(a, b)| a.total != b.total), "every sensor draws other rays");
+    let mean = |readings: &[heliodon_core::light::SensorReading]| readings.iter().map(|r| r.total).sum::<f64>() / readings.len() as f64;
+    let (a, b) = (mean(&first), mean(&second));
+    assert!((a / b - 1.0).abs() < 0.03, "room means {a:.1} and {b:.1} lx");
+    let key = |seed| heliodon_core::light::cache::key(&scene, &settings(seed));
+    assert_ne!(key(0), key(1));
+}
+
 /// A sensor above the roof sees the whole sky and the sun: its reading is
 /// the sky's horizontal irradiance plus the sun's, with nothing in the way.
 #[test]

@@ -98,14 +98,13 @@ pub fn parse_point(text: &str) -> Result<glam::Vec3, String> {
     }
 }
 
-/// The scene's light model, from the cache unless `no_cache`, with the
-/// precomputation's progress bar on standard error.
-pub fn precompute_for_command(scene: Arc<Scene>, no_cache: bool) -> Result<LightModel, String> {
+/// The scene's light model with `settings`, from the cache unless
+/// `no_cache`, with the precomputation's progress bar on standard error.
+pub fn precompute_for_command(scene: Arc<Scene>, settings: LightSettings, no_cache: bool) -> Result<LightModel, String> {
     let cache_dir = if no_cache { None } else { cache::default_dir() };
     let progress = progress_bar("precomputing light");
-    let (model, _) = cache::precompute_cached(scene, LightSettings::default(), cache_dir.as_deref(), &|done| {
-        progress.set_position((done * 1000.0) as u64)
-    })?;
+    let (model, _) =
+        cache::precompute_cached(scene, settings, cache_dir.as_deref(), &|done| progress.set_position((done * 1000.0) as u64))?;
     progress.finish_and_clear();
     Ok(model)
 }

@@ -149,6 +149,10 @@ pub fn key(scene: &Scene, settings: &LightSettings) -> u64 {
         .u64(u64::from(settings.sky_subdivision))
         .u64(settings.max_iterations as u64)
         .u64(settings.tolerance.to_bits());
+    // The default sample keeps the keys it had before seeds were settings.
+    if settings.seed != 0 {
+        hash.u64(settings.seed);
+    }
     hash.0
 }
 

@@ -438,7 +438,7 @@ impl LightModel {
         let window_rays = rays(self.settings.window_rays_per_patch);
         let aimed = self.windows_to_aim_at(patch.centroid.as_dvec3(), reach, normal, window_rays, targets);
         let aimed_window = |w: u32| aimed.iter().any(|a| targets[a.target].window == w);
-        let mut rng = Rng::new(1, side as u64);
+        let mut rng = Rng::seeded(1, self.settings.seed, side as u64);
         let hemisphere = rays(self.settings.rays_per_patch);
         let directions = cosine_directions(normal, hemisphere, &mut rng);
         let (mut coefficients, mut hits) = (Vec::new(), Vec::new());
@@ -604,7 +604,7 @@ impl LightModel {
         let aimed = self.windows_to_aim_at(centre, reach, normal, self.settings.window_rays_per_sensor, targets);
         let aimed_window = |w: u32| aimed.iter().any(|a| targets[a.target].window == w);
         let not_aimed = |way: Way| way.reflected || !way.window.is_some_and(aimed_window);
-        let mut rng = Rng::new(2, index as u64);
+        let mut rng = Rng::seeded(2, self.settings.seed, index as u64);
         let per_point = self.settings.rays_per_sensor.div_ceil(points.len());
         let more_per_point = self.settings.sky_rays_per_sensor.saturating_sub(self.settings.rays_per_sensor).div_ceil(points.len());
         let (mut coefficients, mut hits) = (Vec::new(), Vec::new());

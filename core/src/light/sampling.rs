@@ -15,6 +15,14 @@ impl Rng {
         Self(stream.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ index.wrapping_mul(0xD1B5_4A32_D192_ED03) ^ 0x5851_F42D_4C95_7F2D)
     }
 
+    /// [`Self::new`] in sample `seed` of the stream ([`LightSettings::seed`]):
+    /// seed 0 is the stream itself.
+    ///
+    /// [`LightSettings::seed`]: super::LightSettings::seed
+    pub fn seeded(stream: u64, seed: u64, index: u64) -> Self {
+        Self::new(stream.wrapping_add(seed << 8), index)
+    }
+
     pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;

@@ -64,6 +64,11 @@ pub struct LightSettings {
     pub tolerance: f64,
     /// Worker threads; `None` for all cores. Results do not depend on it.
     pub threads: Option<usize>,
+    /// Which sample of the rays the gathers draw (patch sides' and
+    /// sensors'): another seed is another, equally valid, Monte Carlo
+    /// estimate of the same light, so the readings' spread over seeds is
+    /// their noise. 0 is the default sample.
+    pub seed: u64,
 }
 
 /// Hemisphere rays per patch side times patches that
@@ -90,6 +95,7 @@ impl Default for LightSettings {
             max_iterations: 200,
             tolerance: 1e-4,
             threads: None,
+            seed: 0,
         }
     }
 }

@@ -231,7 +231,7 @@ impl LightModel {
                 return (0.0, reach);
             }
             let triangles = self.patch_triangles(side / 2);
-            let mut rng = Rng::new(3, side as u64);
+            let mut rng = Rng::seeded(3, self.settings.seed, side as u64);
             let normal = self.side_normal(side as u32);
             let total: f64 =
                 (0..n).map(|_| sample_area(&triangles, &mut rng)).map(|point| self.reaching_irradiance(&reach, point, normal, beams)).sum();

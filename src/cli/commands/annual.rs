@@ -12,7 +12,7 @@ use crate::annual::{
 };
 use crate::cli::CliError;
 use crate::cli::args::{Format, load_for_command, precompute_for_command, progress_bar};
-use crate::light::cache;
+use crate::light::{LightSettings, cache};
 use crate::panel::PanelCatalog;
 use crate::report::{csv_field, json_string};
 use crate::site::Site;
@@ -54,8 +54,9 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     let site = &scene.site;
     warn_about_weather(&args.weather, &weather, site);
 
-    let model = precompute_for_command(scene.clone(), args.no_cache)?;
-    let shaded = |down: &[usize]| precompute_for_command(std::sync::Arc::new(scene.with_shades_down(down)), args.no_cache);
+    let settings = LightSettings::default();
+    let model = precompute_for_command(scene.clone(), settings, args.no_cache)?;
+    let shaded = |down: &[usize]| precompute_for_command(std::sync::Arc::new(scene.with_shades_down(down)), settings, args.no_cache);
     let shades: Option<ShadedModel> = (!scene.shades.is_empty() && !args.no_shades).then_some(&shaded);
     // The year's sun at the site: traced once, then from the cache for every
     // weather file (unless its table would not fit in memory: then hour by hour).

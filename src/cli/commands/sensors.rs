@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use crate::cli::CliError;
 use crate::cli::args::{Format, SkyArgs, load_for_command, precompute_for_command, sky_for};
-use crate::light::Lighting;
+use crate::light::{LightSettings, Lighting};
 use crate::panel::PanelCatalog;
 use crate::report::{csv_field, json_string};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
@@ -28,6 +28,10 @@ pub struct SensorsArgs {
     /// Neither read nor write the precomputation cache
     #[arg(long)]
     pub no_cache: bool,
+    /// Which Monte Carlo sample of the rays to draw (0, the default, or any
+    /// other): the readings' spread over a few seeds is their noise
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
 }
 
 /// Prints the readings.
@@ -40,7 +44,8 @@ pub fn run(args: &SensorsArgs, panels: &PanelCatalog) -> Result<(), CliError> {
 pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, String> {
     let spec = args.sky.spec()?;
     let scene = std::sync::Arc::new(load_for_command(&args.scene, panels)?);
-    let model = precompute_for_command(scene.clone(), args.no_cache)?;
+    let settings = LightSettings { seed: args.seed, ..Default::default() };
+    let model = precompute_for_command(scene.clone(), settings, args.no_cache)?;
     // Sensors in the open: outside every room, or a model without one.
     const OUTSIDE: f64 = 0.3;
     let outside: Vec<&str> =

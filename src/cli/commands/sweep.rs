@@ -10,6 +10,7 @@ use crate::annual::{Occupancy, YearSkies};
 use crate::cli::CliError;
 use crate::cli::args::{Format, SkyArgs, load_for_command, precompute_for_command, progress_bar, sky_for};
 use crate::cli::sweep_table::{Row, SDA_ROW, Table, best, key_value};
+use crate::light::LightSettings;
 use crate::panel::PanelCatalog;
 use crate::report::{csv_field, json_string};
 use crate::sweep::{Axis, Grid, MAX_AXES, Target, Variation, parse_shard, sweep};
@@ -123,7 +124,7 @@ pub fn run(args: &SweepArgs, panels: &PanelCatalog) -> Result<(), CliError> {
         Some((k, n)) => grid.shard(k, n),
         None => 0..grid.len(),
     };
-    let mut model = precompute_for_command(scene.clone(), args.no_cache)?;
+    let mut model = precompute_for_command(scene.clone(), LightSettings::default(), args.no_cache)?;
     let progress = progress_bar("sweeping");
     let outcomes = sweep(&mut model, &variation, &grid, range, &sensors, target, &|_, done| progress.set_position((done * 1000.0) as u64));
     progress.finish_and_clear();
