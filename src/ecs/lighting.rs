@@ -187,7 +187,7 @@ fn start_precompute(
     let display = settings.for_display(scene.patches.patches.len());
     engine.refinement = (refine.0 && display != settings).then(|| (scene.clone(), display));
     // The scene's ray-query model lends its tracers.
-    let ray_model = ray_model.map(|m| m.0.clone()).filter(|m| Arc::ptr_eq(&m.scene, &scene));
+    let ray_model = ray_model.and_then(|m| m.of(&scene).cloned());
     engine.precompute = Some(precomputer.spawn(scene, settings, ray_model));
 }
 

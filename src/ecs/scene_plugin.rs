@@ -53,10 +53,18 @@ impl Plugin for ScenePlugin {
 #[derive(Resource, Clone)]
 pub struct RayModel(pub Arc<LightModel>);
 
+impl RayModel {
+    /// The model, where it is `scene`'s (the same `Arc`): a scene just
+    /// replaced may still have its predecessor's for a frame.
+    pub fn of(&self, scene: &Arc<Scene>) -> Option<&Arc<LightModel>> {
+        Arc::ptr_eq(&self.0.scene, scene).then_some(&self.0)
+    }
+}
+
 /// Makes the [`RayModel`] of a scene just spawned.
 fn make_ray_model(mut commands: Commands, active: Res<ActiveScene>, ray_model: Option<Res<RayModel>>) {
     let Some(scene) = active.scene.as_ref().filter(|_| active.is_changed()) else { return };
-    if ray_model.is_none_or(|m| !Arc::ptr_eq(&m.0.scene, scene)) {
+    if ray_model.is_none_or(|m| m.of(scene).is_none()) {
         commands.insert_resource(RayModel(Arc::new(LightModel::unlit(scene.clone()))));
     }
 }

@@ -257,7 +257,7 @@ fn update_sun_pass(
     };
     // Panel windows and their lobes come from the scene's own ray-query
     // model; until it is there, nothing is drawn.
-    let Some(model) = ray_model.map(|m| m.0.clone()).filter(|m| Arc::ptr_eq(&m.scene, scene)) else {
+    let Some(model) = ray_model.as_ref().and_then(|m| m.of(scene)).cloned() else {
         input.0 = None;
         return;
     };

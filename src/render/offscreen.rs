@@ -236,8 +236,8 @@ fn spawn_cameras(
         return;
     }
     let Some(scene) = &active.scene else { return };
-    let model = ray_model.as_ref().map(|m| &*m.0).filter(|m| Arc::ptr_eq(&m.scene, scene));
-    let view = job.request.view.clone().unwrap_or_else(|| initial_view(scene, model));
+    let model = ray_model.as_ref().and_then(|m| m.of(scene));
+    let view = job.request.view.clone().unwrap_or_else(|| initial_view(scene, model.map(|m| m.as_ref())));
     let (width, height) = (job.request.width, job.request.height);
     let picture = images.add(Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None));
     let physical = images.add(Image::new_target_texture(width, height, TextureFormat::Rgba32Float, None));

@@ -142,7 +142,7 @@ fn frame_new_scene(
         *pending = true;
     }
     let Some(scene) = &active.scene else { return };
-    let model = ray_model.as_ref().map(|m| &m.0).filter(|m| std::sync::Arc::ptr_eq(&m.scene, scene));
+    let model = ray_model.as_ref().and_then(|m| m.of(scene));
     if !*pending || (model.is_none() && scene.viewpoints.is_empty()) {
         return;
     }
