@@ -15,7 +15,8 @@ pub mod render;
 pub mod viewer;
 
 pub use heliodon_core::{
-    BUNDLED_SCENES, annual, bundled_scene, day, light, panel, radiance, report, scene, site, sky, sun, sun_pass, sweep, time, weather,
+    BUNDLED_SCENES, annual, bundled_scene, day, light, panel, radiance, report, scene, scene_cache, site, sky, sun, sun_pass, sweep, time,
+    weather,
 };
 
 use bevy::asset::{AssetMetaCheck, AssetPlugin, UnapprovedPathMode};

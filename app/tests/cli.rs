@@ -256,10 +256,12 @@ fn sensors_command_prints_the_contract_csv_and_shares_one_precomputation() {
             expected.sensors[0].total, expected.sensors[0].direct_sun, expected.sensors[0].direct_sky, expected.sensors[0].indirect
         )
     );
-    // A second run reads the cache and says the same.
+    // A second run reads the caches (the light's and the loaded model's) and says the same.
     let Run { out: second, .. } = heliodon(&args, &cache);
     assert_eq!(first, second);
-    assert!(std::fs::read_dir(&cache).unwrap().count() == 1);
+    let files: Vec<String> = std::fs::read_dir(&cache).unwrap().map(|f| f.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert_eq!(files.len(), 2, "{files:?}");
+    assert_eq!(files.iter().filter(|f| f.starts_with("light-scene-")).count(), 1, "{files:?}");
     // Several times and dates in one call.
     let Run { code, out: many, .. } = heliodon(
         &["sensors", scene, "--date", "2026-03-21,2026-06-21", "--time", "09:00,12:00", "--sky", "clear", "--format", "csv"],

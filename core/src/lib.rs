@@ -5,7 +5,7 @@
 //! - the sun and the skies: [`sun`] (NREL SPA), [`sky`] (gensky, gendaylit,
 //!   CIE, sky patches);
 //! - the model: [`scene`] (scene files, OBJ and MTL, surfaces, patches,
-//!   sensors);
+//!   sensors), kept on disk by [`scene_cache`];
 //! - complex fenestration: [`panel`] (the API panel crates implement);
 //! - the light engine: [`light`] (daylight coefficients, form factors,
 //!   radiosity, direct sun and panel beams, the cache), [`day`] (a
@@ -29,6 +29,7 @@ mod parallel;
 pub mod radiance;
 pub mod report;
 pub mod scene;
+pub mod scene_cache;
 pub mod site;
 pub mod sky;
 pub mod sun;

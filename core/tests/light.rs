@@ -694,8 +694,16 @@ fn survey_coordinates_are_recentred_for_precision() {
         .replace("min = [0.5, 0.5]", &format!("min = [{}, {}]", 0.5 + dx, 0.5 + dy))
         .replace("max = [3.5, 5.5]", &format!("max = [{}, {}]", 3.5 + dx, 5.5 + dy));
     std::fs::write(&far, text).unwrap();
-    let far = load_scene(&far, &PanelCatalog::new()).unwrap();
+    let far_file = far;
+    let far = load_scene(&far_file, &PanelCatalog::new()).unwrap();
     assert!(far.warnings.iter().any(|w| w.message.contains("recentred")), "{:?}", far.warnings);
+    // Read back from the scene cache, the sensors are placed in the recentred frame too.
+    let cache = far_file.with_file_name("cache");
+    let _ = std::fs::remove_dir_all(&cache);
+    for _ in 0..2 {
+        let (cached, _) = heliodon_core::scene_cache::load_scene_cached(&far_file, &PanelCatalog::new(), Some(&cache)).unwrap();
+        assert_eq!(format!("{cached:?}"), format!("{far:?}"));
+    }
     let near = load(&near);
     let far = Arc::new(far.scene);
     assert_eq!(far.patches.patches.len(), near.patches.patches.len());

@@ -370,3 +370,56 @@ fn sensor_names_are_unique_and_grids_non_empty() {
     let f = fixture("empty_grid", &scene_toml(grid), OBJ);
     assert_eq!(f.error().location.key.as_deref(), Some("sensor_grids[0].max"));
 }
+
+#[test]
+fn the_scene_cache_gives_the_scene_its_files_give() {
+    use heliodon_core::light::cache::CacheOutcome;
+    use heliodon_core::scene_cache::load_scene_cached;
+    let office = heliodon_core::bundled_scene("office");
+    let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scene_cache_office");
+    let _ = std::fs::remove_dir_all(&work);
+    std::fs::create_dir_all(&work).unwrap();
+    for file in ["scene.toml", "model.mtl"] {
+        std::fs::copy(office.with_file_name(file), work.join(file)).unwrap();
+    }
+    // A face written twice: the warning the load gives must come from the cache too.
+    let obj = std::fs::read_to_string(office.with_file_name("model.obj")).unwrap();
+    let face = obj.lines().find(|l| l.starts_with("f ")).unwrap();
+    let twice = obj.replacen(face, &format!("{face}\n{face}"), 1);
+    std::fs::write(work.join("model.obj"), &twice).unwrap();
+    let scene = work.join("scene.toml");
+    let dir = work.join("cache");
+    let same_as_files = |loaded: &LoadedScene| {
+        let uncached = load_scene(&scene, &no_panels()).unwrap();
+        assert!(uncached.warnings.iter().any(|w| w.message.contains("duplicated")), "{:?}", uncached.warnings);
+        assert_eq!(format!("{loaded:?}"), format!("{uncached:?}"));
+    };
+    let (stored, outcome) = load_scene_cached(&scene, &no_panels(), Some(&dir)).unwrap();
+    let CacheOutcome::Stored(path) = outcome else { panic!("{outcome:?}") };
+    same_as_files(&stored);
+    let (read, outcome) = load_scene_cached(&scene, &no_panels(), Some(&dir)).unwrap();
+    assert_eq!(outcome, CacheOutcome::Hit(path.clone()));
+    same_as_files(&read);
+    // An MTL library edited (its path comes from the OBJ, so it is checked on reading).
+    let mtl = std::fs::read_to_string(work.join("model.mtl")).unwrap();
+    std::fs::write(work.join("model.mtl"), format!("{mtl}\n# edited\n")).unwrap();
+    let (read, outcome) = load_scene_cached(&scene, &no_panels(), Some(&dir)).unwrap();
+    assert_eq!(outcome, CacheOutcome::Rebuilt(path.clone(), "an MTL library changed".into()));
+    same_as_files(&read);
+    // A damaged file is rebuilt, never trusted.
+    let mut damaged = std::fs::read(&path).unwrap();
+    let middle = damaged.len() / 2;
+    damaged[middle] ^= 0x10;
+    std::fs::write(&path, damaged).unwrap();
+    let (read, outcome) = load_scene_cached(&scene, &no_panels(), Some(&dir)).unwrap();
+    assert_eq!(outcome, CacheOutcome::Rebuilt(path.clone(), "checksum mismatch".into()));
+    same_as_files(&read);
+    // Another OBJ (or scene file) is another file; no folder, no cache.
+    std::fs::write(work.join("model.obj"), format!("{twice}\n# edited\n")).unwrap();
+    let (read, outcome) = load_scene_cached(&scene, &no_panels(), Some(&dir)).unwrap();
+    assert!(matches!(&outcome, CacheOutcome::Stored(p) if *p != path), "{outcome:?}");
+    same_as_files(&read);
+    let (read, outcome) = load_scene_cached(&scene, &no_panels(), None).unwrap();
+    assert_eq!(outcome, CacheOutcome::Skipped("disabled".into()));
+    same_as_files(&read);
+}

@@ -9,7 +9,8 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::light::{LightModel, LightSettings, cache};
 use crate::panel::PanelCatalog;
-use crate::scene::{self, Scene};
+use crate::scene::Scene;
+use crate::scene_cache;
 use crate::sky::{Sky, SkyInputs, SkySpec, sky_at};
 use crate::sun::SolarPosition;
 use crate::time::{Date, LocalDateTime, TimeOfDay};
@@ -118,9 +119,11 @@ pub fn progress_bar(label: &str) -> ProgressBar {
     bar
 }
 
-/// Loads a scene for a command, printing its warnings.
-pub fn load_for_command(path: &Path, panels: &PanelCatalog) -> Result<Scene, String> {
-    let loaded = scene::load_scene(path, panels).map_err(|e| e.to_string())?;
+/// Loads a scene for a command, printing its warnings; through the scene
+/// cache unless `no_cache`.
+pub fn load_for_command(path: &Path, panels: &PanelCatalog, no_cache: bool) -> Result<Scene, String> {
+    let cache_dir = if no_cache { None } else { cache::default_dir() };
+    let (loaded, _) = scene_cache::load_scene_cached(path, panels, cache_dir.as_deref()).map_err(|e| e.to_string())?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }

@@ -2,7 +2,8 @@
 //! factors, sensor rays) are stored under a key hashed from what they
 //! depend on ([`key`]: the loaded geometry and patches, the materials' light
 //! passing, the sensors' placement, the settings and this format's version;
-//! not comments or names); the BVH is rebuilt on load. A file whose header, length or checksum does not
+//! not comments or names), with the shadow tracer's BVH (building it was
+//! most of a warm start on a large model). A file whose header, length or checksum does not
 //! match is rebuilt, never trusted. Files are written whole and renamed into
 //! place (a reader never sees half a file), and the folder is kept under a
 //! size bound ([`size_limit`]), least recently used files first to go;
@@ -16,6 +17,7 @@ use std::time::{Duration, SystemTime};
 
 use glam::DVec3;
 
+use super::bvh::Tracer;
 use super::gather::{Gather, SensorGeometry};
 use super::landings::Landings;
 use super::{LightModel, LightSettings};
@@ -25,7 +27,7 @@ use crate::sky::SkyPatches;
 
 const MAGIC: &[u8; 8] = b"HELIOLT\0";
 /// Bump when the model or its layout changes.
-const FORMAT: u32 = 12;
+const FORMAT: u32 = 13;
 
 /// What happened to the cache.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -181,36 +183,36 @@ pub fn precompute_cached_beside(
     progress: &(dyn Fn(f64) + Sync),
 ) -> Result<(LightModel, CacheOutcome), String> {
     settings.check()?;
-    // Every start needs the model (its shadow tracer, windows, openings)
-    // and the key, so they are made side by side; so are the sides inside
-    // solids, which only a gather needs, where no cache file is there to
-    // read.
-    let (empty, (key, dark)) = par_join(
-        settings.threads,
-        || LightModel::empty(scene.clone(), settings, beside),
-        || {
-            let key = key(&scene, &settings);
-            let cached = dir.is_some_and(|dir| file_path(dir, &file_name(key)).exists());
-            (key, (!cached).then(|| super::solids::dark_sides(&scene)))
-        },
-    );
-    let empty = std::cell::Cell::new(Some(empty));
-    let take = || empty.take().expect("the model is loaded or gathered, once");
-    let (model, outcome) = through_cache(
-        dir,
-        &file_name(key),
-        key,
-        |payload| {
-            let (side_gathers, sensors) = LightModel::read_payload(&scene, &settings, payload)?;
-            Some(LightModel { side_gathers, sensors, ..take() }.sharing(beside))
-        },
-        || {
-            super::gather::check_memory(&scene, &settings)?;
-            let dark = dark.unwrap_or_else(|| super::solids::dark_sides(&scene));
-            Ok(take().gathered(&dark, beside, progress))
-        },
-        LightModel::payload,
-    )?;
+    let key = key(&scene, &settings);
+    let compute = || {
+        // The model (its shadow tracer, windows, openings) and the sides
+        // inside solids are made side by side.
+        let (empty, dark) =
+            par_join(settings.threads, || LightModel::empty(scene.clone(), settings, beside, None), || super::solids::dark_sides(&scene));
+        super::gather::check_memory(&scene, &settings)?;
+        Ok::<_, String>(empty.gathered(&dark, beside, progress))
+    };
+    let (model, outcome) = match dir {
+        None => (compute()?, CacheOutcome::Skipped("disabled".into())),
+        Some(dir) => {
+            let (path, found) = open_entry(dir, &file_name(key), key);
+            let rebuilt = match found {
+                None => None,
+                Some(Err(why)) => Some(why),
+                Some(Ok(payload)) => match LightModel::read_cached(&scene, settings, beside, &payload) {
+                    Some(model) => {
+                        mark_used(&path);
+                        model.cache_key.get_or_init(|| key);
+                        return Ok((model, CacheOutcome::Hit(path)));
+                    }
+                    None => Some(DOES_NOT_FIT.to_string()),
+                },
+            };
+            let model = compute()?;
+            let outcome = store_entry(dir, path, key, &model.payload(), rebuilt);
+            (model, outcome)
+        }
+    };
     model.cache_key.get_or_init(|| key);
     Ok((model, outcome))
 }
@@ -239,39 +241,68 @@ pub fn through_cache<T>(
     let Some(dir) = dir else {
         return Ok((compute()?, CacheOutcome::Skipped("disabled".into())));
     };
+    let (path, found) = open_entry(dir, name, key);
+    let rebuilt = match found {
+        None => None,
+        Some(Ok(payload)) => match load(&payload) {
+            Some(value) => {
+                mark_used(&path);
+                return Ok((value, CacheOutcome::Hit(path)));
+            }
+            None => Some(DOES_NOT_FIT.to_string()),
+        },
+        Some(Err(why)) => Some(why),
+    };
+    let value = compute()?;
+    let outcome = store_entry(dir, path, key, &save(&value), rebuilt);
+    Ok((value, outcome))
+}
+
+/// The cache file `name` in `dir` (its path) and its payload: `None` when
+/// there is none, `Some(Err(why))` when it is not whole or not stored under
+/// `key`. A caller that uses the payload marks the file used
+/// ([`mark_used`]); one that cannot makes it again ([`store_entry`]).
+pub(crate) fn open_entry(dir: &Path, name: &str, key: u64) -> (PathBuf, Option<Result<Payload, String>>) {
     let path = file_path(dir, name);
     // Every start tidies: temporary files of processes killed mid-write go,
     // and the folder keeps to its bound.
     tidy(dir, &path, size_limit());
-    let mut rebuilt = None;
-    if let Ok(bytes) = fs::read(&path) {
-        match decode(&bytes, key) {
-            Ok(payload) => match load(payload) {
-                Some(value) => {
-                    mark_used(&path);
-                    return Ok((value, CacheOutcome::Hit(path)));
-                }
-                None => rebuilt = Some(DOES_NOT_FIT.to_string()),
-            },
-            Err(why) => rebuilt = Some(why),
-        }
+    let found = fs::read(&path).ok().map(|bytes| {
+        decode(&bytes, key)?;
+        Ok(Payload(bytes))
+    });
+    (path, found)
+}
+
+/// A cache file read whole and checked: it derefs to its payload.
+pub(crate) struct Payload(Vec<u8>);
+
+impl std::ops::Deref for Payload {
+    type Target = [u8];
+
+    fn deref(&self) -> &[u8] {
+        &self.0[HEADER..]
     }
-    let value = compute()?;
+}
+
+/// Stores `payload` under `key` at `path` (from [`open_entry`]): written
+/// whole, then renamed into place. `rebuilt` says why a file there was
+/// not used.
+pub(crate) fn store_entry(dir: &Path, path: PathBuf, key: u64, payload: &[u8], rebuilt: Option<String>) -> CacheOutcome {
     let stored = fs::create_dir_all(dir).and_then(|_| {
         // Write then rename, so a reader never sees half a file.
         let partial = temporary_path(&path);
-        write_file(&partial, &save(&value), key)?;
+        write_file(&partial, payload, key)?;
         fs::rename(&partial, &path)
     });
     if stored.is_ok() {
         tidy(dir, &path, size_limit());
     }
-    let outcome = match (stored, rebuilt) {
+    match (stored, rebuilt) {
         (Err(e), _) => CacheOutcome::Skipped(format!("cannot write {}: {e}", path.display())),
         (Ok(()), Some(why)) => CacheOutcome::Rebuilt(path, why),
         (Ok(()), None) => CacheOutcome::Stored(path),
-    };
-    Ok((value, outcome))
+    }
 }
 
 /// [`through_cache`] for a file too big to hold in memory: loaded in place
@@ -315,7 +346,7 @@ pub(crate) fn through_streamed_cache<T>(
 pub(crate) const DOES_NOT_FIT: &str = "its contents do not fit the scene";
 
 /// Used now: the last file to be evicted.
-fn mark_used(path: &Path) {
+pub(crate) fn mark_used(path: &Path) {
     let _ = fs::File::options().append(true).open(path).and_then(|f| f.set_modified(SystemTime::now()));
 }
 
@@ -555,6 +586,10 @@ impl Writer {
         self.0.extend_from_slice(&v.to_le_bytes());
     }
 
+    pub fn u64(&mut self, v: u64) {
+        self.0.extend_from_slice(&v.to_le_bytes());
+    }
+
     pub fn vec3(&mut self, v: DVec3) {
         self.f64(v.x);
         self.f64(v.y);
@@ -657,6 +692,10 @@ impl Reader<'_> {
         self.take(8).map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes")))
     }
 
+    pub fn u64(&mut self) -> Option<u64> {
+        self.take(8).map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes")))
+    }
+
     pub fn vec3(&mut self) -> Option<DVec3> {
         Some(DVec3::new(self.f64()?, self.f64()?, self.f64()?))
     }
@@ -709,6 +748,12 @@ impl LightModel {
     /// The gathered data, for the cache.
     fn payload(&self) -> Vec<u8> {
         let mut w = Writer::default();
+        // The shadow tracer first, its length before it: a model beside
+        // another skips it (it shares the other's).
+        let mut tracer = Writer::default();
+        self.shadow_tracer.write(&mut tracer);
+        w.u64(tracer.0.len() as u64);
+        w.0.extend_from_slice(&tracer.0);
         w.u32(self.side_gathers.len() as u32);
         self.side_gathers.iter().for_each(|g| w.gather(g));
         w.u32(self.sensors.len() as u32);
@@ -716,9 +761,28 @@ impl LightModel {
         w.0
     }
 
-    /// The side gathers and sensor geometries a payload holds, if they fit
-    /// the scene.
-    fn read_payload(scene: &Scene, settings: &LightSettings, payload: &[u8]) -> Option<Gathered> {
+    /// The model a payload holds, if it fits the scene: its shadow tracer
+    /// read back (or `beside`'s, shared), its gathers and sensors.
+    fn read_cached(scene: &Arc<Scene>, settings: LightSettings, beside: Option<&LightModel>, payload: &[u8]) -> Option<Self> {
+        let mut r = Reader(payload);
+        let tracer_len = usize::try_from(r.u64()?).ok().filter(|&n| n <= r.0.len())?;
+        let (tracer_bytes, rest) = r.0.split_at(tracer_len);
+        let shadow_tracer = match beside.filter(|b| Arc::ptr_eq(&b.scene, scene)) {
+            Some(beside) => beside.shadow_tracer.clone(),
+            None => {
+                let (triangles, owner) = LightModel::shadow_casters(scene);
+                let mut r = Reader(tracer_bytes);
+                Arc::new(Tracer::read(&mut r, &triangles, &owner).filter(|_| r.is_empty())?)
+            }
+        };
+        let (side_gathers, sensors) = Self::read_payload(scene, settings, rest)?;
+        let empty = Self::empty(scene.clone(), settings, beside, Some(shadow_tracer));
+        Some(LightModel { side_gathers, sensors, ..empty }.sharing(beside))
+    }
+
+    /// The side gathers and sensor geometries a payload holds after its
+    /// tracer, if they fit the scene.
+    fn read_payload(scene: &Scene, settings: LightSettings, payload: &[u8]) -> Option<Gathered> {
         let mut r = Reader(payload);
         let sides = r.u32()? as usize;
         if sides != scene.patches.patches.len() * 2 {

@@ -271,7 +271,7 @@ impl LightModel {
         settings.check()?;
         check_memory(&scene, &settings)?;
         let dark = super::solids::dark_sides(&scene);
-        Ok(Self::empty(scene, settings, None).gathered(&dark, None, progress))
+        Ok(Self::empty(scene, settings, None, None).gathered(&dark, None, progress))
     }
 
     /// This model, made by [`Self::empty`], with every patch side's and

@@ -215,7 +215,7 @@ impl LightModel {
     /// for ray queries ([`Self::trace`], [`Self::sun_irradiance`]), not for
     /// lighting.
     pub fn unlit(scene: Arc<Scene>) -> Self {
-        Self::empty(scene, LightSettings::default(), None).with_tracer()
+        Self::empty(scene, LightSettings::default(), None, None).with_tracer()
     }
 
     /// This model with its patch tracer built now, not at the first ray
@@ -240,19 +240,23 @@ impl LightModel {
         self.tracer.get_or_init(|| Arc::new(Tracer::new(&self.scene.patches)))
     }
 
+    /// The triangles the shadow tracer is built over, each owned by its
+    /// surface.
+    fn shadow_casters(scene: &Scene) -> (Vec<[glam::Vec3; 3]>, Vec<u32>) {
+        let triangles = scene.triangles.iter().map(|t| t.vertices).collect();
+        let owner = scene.surfaces.iter().enumerate().flat_map(|(k, s)| std::iter::repeat_n(k as u32, s.triangles.len())).collect();
+        (triangles, owner)
+    }
+
     /// The model with its tracer and materials but nothing gathered yet;
-    /// the tracers those of `beside` where it has them and the same scene.
-    fn empty(scene: Arc<Scene>, settings: LightSettings, beside: Option<&LightModel>) -> Self {
+    /// the shadow tracer `shadow_tracer` when given, else the tracers those
+    /// of `beside` where it has them and the same scene.
+    fn empty(scene: Arc<Scene>, settings: LightSettings, beside: Option<&LightModel>, shadow_tracer: Option<Arc<Tracer>>) -> Self {
         let beside = beside.filter(|b| Arc::ptr_eq(&b.scene, &scene));
-        let shadow_tracer = beside.map_or_else(
-            || {
-                Arc::new(Tracer::over(
-                    &scene.triangles.iter().map(|t| t.vertices).collect::<Vec<_>>(),
-                    scene.surfaces.iter().enumerate().flat_map(|(k, s)| std::iter::repeat_n(k as u32, s.triangles.len())).collect(),
-                ))
-            },
-            |b| b.shadow_tracer.clone(),
-        );
+        let shadow_tracer = shadow_tracer.or_else(|| beside.map(|b| b.shadow_tracer.clone())).unwrap_or_else(|| {
+            let (triangles, owner) = Self::shadow_casters(&scene);
+            Arc::new(Tracer::over(&triangles, owner))
+        });
         let tracer = beside.and_then(|b| b.tracer.get()).cloned().map_or_else(std::sync::OnceLock::new, std::sync::OnceLock::from);
         let surfaces = scene
             .materials

@@ -24,12 +24,13 @@ mod shades;
 pub(crate) mod shells;
 mod surfaces;
 
+use std::collections::BTreeMap;
 use std::future::Future;
 use std::io;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 pub use cut_plane::CutPlane;
 pub use error::{Location, SceneError, SceneWarning, line_of};
@@ -225,22 +226,47 @@ pub fn load_scene(path: &Path, panels: &PanelCatalog) -> Result<LoadedScene, Sce
 
 /// Loads a scene file and everything it refers to through `reader`.
 pub async fn load_scene_with(scene_path: &Path, panels: &PanelCatalog, reader: &mut impl SceneReader) -> Result<LoadedScene, SceneError> {
+    let (mut parsed, obj_path, obj_text) = read_scene_and_obj(scene_path, reader).await?;
+    let (built, mtls) = build_model(&mut parsed, &obj_path, &obj_text, panels, reader).await?;
+    assemble(parsed, obj_path, mtls.into_iter().map(|(path, _)| path).collect(), built)
+}
+
+/// The scene file, parsed, with its OBJ's path and text: what a load
+/// starts from (and the scene cache's key is made of).
+pub(crate) async fn read_scene_and_obj(
+    scene_path: &Path,
+    reader: &mut impl SceneReader,
+) -> Result<(file::ParsedScene, PathBuf, String), SceneError> {
     let scene_text = read_text(reader, scene_path, None).await?;
     let parsed = file::parse(scene_path, &scene_text)?;
     let obj_path = parsed.obj_path();
     let obj_text = read_text(reader, &obj_path, Some(parsed.obj_location())).await?;
-    let obj_scan = obj::scan(&obj_path, &obj_text)?;
+    Ok((parsed, obj_path, obj_text))
+}
+
+/// Reads the MTL libraries the OBJ names and builds the model from them
+/// (the costly part of a load); also gives the libraries (paths and text).
+/// A model in survey coordinates moves `parsed`'s frame origin to its centre.
+pub(crate) async fn build_model(
+    parsed: &mut file::ParsedScene,
+    obj_path: &Path,
+    obj_text: &str,
+    panels: &PanelCatalog,
+    reader: &mut impl SceneReader,
+) -> Result<(BuiltModel, Vec<(PathBuf, String)>), SceneError> {
+    let obj_scan = obj::scan(obj_path, obj_text)?;
     let mut mtls = Vec::new();
     for library in &obj_scan.material_libraries {
         let path = obj_path.parent().unwrap_or(Path::new("")).join(&library.name);
-        let location = Location::line(&obj_path, library.line);
+        let location = Location::line(obj_path, library.line);
         let text = read_text(reader, &path, Some(location)).await?;
         mtls.push((path, text));
     }
-    build(parsed, obj_path, &obj_text, obj_scan, mtls, panels)
+    let built = build(parsed, obj_path, obj_text, obj_scan, &mtls, panels)?;
+    Ok((built, mtls))
 }
 
-async fn read_text(reader: &mut impl SceneReader, path: &Path, referenced_at: Option<Location>) -> Result<String, SceneError> {
+pub(crate) async fn read_text(reader: &mut impl SceneReader, path: &Path, referenced_at: Option<Location>) -> Result<String, SceneError> {
     let bytes = reader.read(path).await.map_err(|error| {
         let what = match error.kind() {
             io::ErrorKind::NotFound => "not found".to_string(),
@@ -259,24 +285,40 @@ async fn read_text(reader: &mut impl SceneReader, path: &Path, referenced_at: Op
     })
 }
 
+/// What loading makes of the model's files: the costly part of a load,
+/// which the scene cache keeps; the rest ([`assemble`]) is read from the
+/// scene file each time.
+#[derive(Debug, Clone)]
+pub(crate) struct BuiltModel {
+    pub materials: Vec<Material>,
+    /// Materials of `[materials]` no face uses (a shade may).
+    pub unused_materials: BTreeMap<String, Material>,
+    /// The model-space point placed at the canonical origin.
+    pub origin: DVec3,
+    pub triangles: Vec<Triangle>,
+    pub surfaces: Vec<Surface>,
+    pub windows: Vec<Window>,
+    pub patches: PatchMesh,
+    pub warnings: Vec<SceneWarning>,
+}
+
 fn build(
-    mut parsed: file::ParsedScene,
-    obj_path: PathBuf,
+    parsed: &mut file::ParsedScene,
+    obj_path: &Path,
     obj_text: &str,
     obj_scan: obj::ObjScan,
-    mtls: Vec<(PathBuf, String)>,
+    mtls: &[(PathBuf, String)],
     panels: &PanelCatalog,
-) -> Result<LoadedScene, SceneError> {
+) -> Result<BuiltModel, SceneError> {
     let mut warnings = Vec::new();
-    let model = obj::import(&obj_path, obj_text, &obj_scan, &mtls)?;
-    let (materials, material_of, unused_materials) = material::resolve(&parsed, &model, panels, &obj_path, &mut warnings)?;
-    let shades = shades::shade_groups(&parsed, &materials, &unused_materials)?;
+    let model = obj::import(obj_path, obj_text, &obj_scan, mtls)?;
+    let (materials, material_of, unused_materials) = material::resolve(parsed, &model, panels, obj_path, &mut warnings)?;
     // A model in survey coordinates is recentred, in f64, before anything
     // becomes f32 (which keeps millimetres only within a few km of 0).
     if let Some(centre) = obj::far_centre(&model, RECENTRE_BEYOND) {
         parsed.frame.origin = centre;
         warnings.push(SceneWarning {
-            location: Location::file(&obj_path),
+            location: Location::file(obj_path),
             message: format!(
                 "the model lies {:.0} km from its origin (survey coordinates?): it is recentred on ({:.3}, {:.3}, {:.3}) for precision; positions heliodon prints are relative to that point",
                 centre.length() * f64::from(parsed.frame.scale) / 1000.0,
@@ -286,12 +328,12 @@ fn build(
             ),
         });
     }
-    let raw_triangles = obj::triangles(&model, &parsed.frame, &material_of, &obj_path, &mut warnings)?;
+    let raw_triangles = obj::triangles(&model, &parsed.frame, &material_of, obj_path, &mut warnings)?;
     let (mut triangles, mut surfaces) = surfaces::group(raw_triangles);
     let (box_faces, panes) = repair::thick_glass(&triangles, &surfaces, &materials);
     if panes > 0 {
         warnings.push(SceneWarning {
-            location: Location::file(&obj_path),
+            location: Location::file(obj_path),
             message: format!(
                 "{panes} glass panes are modelled as boxes (two faces up to {} cm apart): each is read as one pane, its far face and edges dropped ({} surfaces)",
                 repair::MAX_PANE_THICKNESS * 100.0,
@@ -307,26 +349,8 @@ fn build(
         (triangles, surfaces) = surfaces::group(keep);
     }
     let windows = surfaces::windows(&triangles, &surfaces, &materials);
-    let sensors = sensors::sensors(&parsed)?;
-    let window_bounds: Vec<(Vec3, Vec3)> = windows
-        .iter()
-        .map(|w| {
-            let range = surfaces[w.surface as usize].triangles.clone();
-            bounds(&triangles[range.start as usize..range.end as usize])
-        })
-        .collect();
-    // What views frame: the windows and the sensors.
-    let focus = window_bounds
-        .iter()
-        .copied()
-        .chain(sensors.iter().map(|s| (s.position, s.position)))
-        .reduce(|(lo, hi), (a, b)| (lo.min(a), hi.max(b)));
-    // Patches are finest around the sensors and the windows that light them (see `patches`).
-    let sizing = if parsed.adaptive_patches {
-        PatchSizing::around(parsed.patch_size, &sensors, &window_bounds)
-    } else {
-        PatchSizing::uniform(parsed.patch_size)
-    };
+    let sensors = sensors::sensors(parsed)?;
+    let (sizing, _) = sizing_and_focus(parsed, &sensors, &triangles, &surfaces, &windows);
     // Clutter gathers into clusters; windows keep patches of their own.
     let clusterable: Vec<bool> =
         surfaces.iter().map(|s| matches!(materials[s.material as usize].kind, MaterialKind::Diffuse { .. })).collect();
@@ -366,7 +390,7 @@ fn build(
         .collect();
     if let Some(&(first, share)) = covered.first() {
         warnings.push(SceneWarning {
-            location: Location::file(&obj_path),
+            location: Location::file(obj_path),
             message: format!(
                 "{} windows lie under an opaque face in their own plane (the first, window #{first} of material '{}', {:.0}% covered): whether light passes there is up to the ray tracer, and Radiance and heliodon may disagree; remove the covering faces (an IFC zone exported as geometry?)",
                 covered.len(),
@@ -376,13 +400,59 @@ fn build(
         });
     }
     let patches = patches::subdivide(&triangles, &mut surfaces, &sizing, &clusterable, &window_planes, &large);
+    Ok(BuiltModel { materials, unused_materials, origin: parsed.frame.origin, triangles, surfaces, windows, patches, warnings })
+}
+
+/// Where patches are finest ([`PatchSizing`]) and what views frame (the
+/// windows and the sensors; `None` with neither).
+fn sizing_and_focus(
+    parsed: &file::ParsedScene,
+    sensors: &[Sensor],
+    triangles: &[Triangle],
+    surfaces: &[Surface],
+    windows: &[Window],
+) -> (PatchSizing, Option<(Vec3, Vec3)>) {
+    let window_bounds: Vec<(Vec3, Vec3)> = windows
+        .iter()
+        .map(|w| {
+            let range = surfaces[w.surface as usize].triangles.clone();
+            bounds(&triangles[range.start as usize..range.end as usize])
+        })
+        .collect();
+    let focus = window_bounds
+        .iter()
+        .copied()
+        .chain(sensors.iter().map(|s| (s.position, s.position)))
+        .reduce(|(lo, hi), (a, b)| (lo.min(a), hi.max(b)));
+    // Patches are finest around the sensors and the windows that light them (see `patches`).
+    let sizing = if parsed.adaptive_patches {
+        PatchSizing::around(parsed.patch_size, sensors, &window_bounds)
+    } else {
+        PatchSizing::uniform(parsed.patch_size)
+    };
+    (sizing, focus)
+}
+
+/// The scene: the built model with what the scene file says besides
+/// (site, sensors, cameras, shades).
+pub(crate) fn assemble(
+    mut parsed: file::ParsedScene,
+    obj_path: PathBuf,
+    mtls: Vec<PathBuf>,
+    built: BuiltModel,
+) -> Result<LoadedScene, SceneError> {
+    let BuiltModel { materials, unused_materials, origin, triangles, surfaces, windows, patches, warnings } = built;
+    // Sensors and cameras are placed in the model's frame, recentred or not.
+    parsed.frame.origin = origin;
+    let shades = shades::shade_groups(&parsed, &materials, &unused_materials)?;
+    let sensors = sensors::sensors(&parsed)?;
     let viewpoints = sensors::viewpoints(&parsed)?;
+    let (patch_sizing, focus) = sizing_and_focus(&parsed, &sensors, &triangles, &surfaces, &windows);
     let bounds = bounds(&triangles);
-    let focus = focus.unwrap_or(bounds);
     Ok(LoadedScene {
         scene: Scene {
-            name: parsed.name.clone(),
-            files: SceneFiles { scene: parsed.path.clone(), obj: obj_path, mtls: mtls.into_iter().map(|(path, _)| path).collect() },
+            name: parsed.name,
+            files: SceneFiles { scene: parsed.path, obj: obj_path, mtls },
             site: parsed.site,
             frame: parsed.frame,
             patch_size: parsed.patch_size,
@@ -395,8 +465,8 @@ fn build(
             viewpoints,
             shades,
             bounds,
-            focus,
-            patch_sizing: sizing,
+            focus: focus.unwrap_or(bounds),
+            patch_sizing,
         },
         warnings,
     })

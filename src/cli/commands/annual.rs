@@ -43,7 +43,7 @@ pub struct AnnualArgs {
 
 /// Runs the year and prints the per-sensor metrics.
 pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
-    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels)?);
+    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels, args.no_cache)?);
     if scene.sensors.is_empty() {
         return Err(CliError::failure(format!(
             "{}: the scene has no sensors; an annual study reads sensors ([[sensors]] or [[sensor_grids]])",

@@ -18,7 +18,7 @@ pub struct ExportArgs {
 /// Writes the Radiance model into `--out`.
 pub fn run(args: &ExportArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     let (case, spec) = (&args.case, args.case.sky.spec()?);
-    let scene = load_for_command(&case.scene, panels)?;
+    let scene = load_for_command(&case.scene, panels, false)?;
     let when = case.when();
     let (position, sky) = sky_for(&scene, &spec, &case.sky.sky, when)?;
     let label = format!(

@@ -65,7 +65,7 @@ fn parse_mode(text: &str) -> Result<RenderMode, String> {
 /// Renders the view and writes the PNG (and the HDR).
 pub fn run(args: &RenderArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     let (case, sky) = (&args.case, args.case.sky.spec()?);
-    let scene = load_for_command(&case.scene, panels)?;
+    let scene = load_for_command(&case.scene, panels, false)?;
     let mut view = match &args.camera {
         Some(name) => Some(scene.viewpoints.iter().find(|v| &v.name == name).cloned().ok_or_else(|| {
             let known: Vec<&str> = scene.viewpoints.iter().map(|v| v.name.as_str()).collect();

@@ -43,7 +43,7 @@ pub fn run(args: &SensorsArgs, panels: &PanelCatalog) -> Result<(), CliError> {
 /// The `sensors` command: one precomputation, then every date × time.
 pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, String> {
     let spec = args.sky.spec()?;
-    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels)?);
+    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels, args.no_cache)?);
     let settings = LightSettings { seed: args.seed, ..Default::default() };
     let model = precompute_for_command(scene.clone(), settings, args.no_cache)?;
     // Sensors in the open: outside every room, or a model without one.

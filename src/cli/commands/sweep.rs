@@ -84,7 +84,7 @@ pub fn run(args: &SweepArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     if args.weather.is_none() && args.date.is_none() {
         return Err(CliError::usage("a sweep needs an instant (--date and --time) or a year (--weather FILE.epw)"));
     }
-    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels)?);
+    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels, args.no_cache)?);
     let grid = Grid { axes: args.vary.clone() };
     let variation = Variation::new(&scene, &args.material, &grid, panels)?;
     let sensors: Vec<usize> = match &args.sensor {
