@@ -11,7 +11,6 @@
 //! the model file's vertices ([`super::Triangle::file_vertices`]).
 
 use glam::{DVec3, Vec3};
-use rustc_hash::FxHashMap;
 
 /// What else meets a triangle's edge.
 #[derive(Debug, Clone, Copy)]
@@ -39,30 +38,31 @@ impl Edges {
     }
 
     /// `corner(3t + k)` is corner k of triangle t, as something equal where
-    /// the corners are one (hashed with Fx, not SipHash: the keys are the
-    /// model's own points or vertex numbers).
-    pub(crate) fn between<K: Copy + Ord + std::hash::Hash>(triangles: usize, corner: impl Fn(usize) -> K) -> Self {
-        let mut by_corners: FxHashMap<(K, K), Vec<u32>> = FxHashMap::default();
-        by_corners.reserve(triangles * 2);
+    /// the corners are one. The edges are grouped by sorting them by their
+    /// ends, not through a map of lists (a list allocated per edge was most
+    /// of finding a large model's shells).
+    pub(crate) fn between<K: Copy + Ord>(triangles: usize, corner: impl Fn(usize) -> K) -> Self {
         let mut forward = Vec::with_capacity(triangles * 3);
+        let mut by_ends: Vec<((K, K), u32)> = Vec::with_capacity(triangles * 3);
         for edge in 0..triangles * 3 {
             let (p, q) = (corner(edge), corner(edge - edge % 3 + (edge + 1) % 3));
             forward.push(p < q);
-            by_corners.entry((p.min(q), p.max(q))).or_default().push(edge as u32);
+            by_ends.push(((p.min(q), p.max(q)), edge as u32));
         }
+        by_ends.sort_unstable();
         let mut meets = vec![Meeting::Open; triangles * 3];
         let mut crowds = Vec::new();
-        for edges in by_corners.into_values() {
-            match edges[..] {
+        for edges in by_ends.chunk_by(|a, b| a.0 == b.0) {
+            match *edges {
                 [_] => {}
-                [first, second] => {
+                [(_, first), (_, second)] => {
                     let same = forward[first as usize] == forward[second as usize];
                     meets[first as usize] = Meeting::Pair(second, same);
                     meets[second as usize] = Meeting::Pair(first, same);
                 }
                 _ => {
-                    edges.iter().for_each(|&edge| meets[edge as usize] = Meeting::Crowd);
-                    crowds.push(edges);
+                    edges.iter().for_each(|&(_, edge)| meets[edge as usize] = Meeting::Crowd);
+                    crowds.push(edges.iter().map(|&(_, edge)| edge).collect());
                 }
             }
         }
