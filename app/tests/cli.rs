@@ -429,6 +429,46 @@ fn export_radiance_gives_bsdf_panels_their_data() {
 
 // ---- annual ----------------------------------------------------------------------
 
+/// `--seed` draws another Monte Carlo sample of the rays in `sweep` and
+/// `annual` as it does in `sensors`; a seed that is not a number is named.
+#[test]
+fn sweep_and_annual_take_a_seed() {
+    let room = bundled_scene("test_room");
+    let room = room.to_str().unwrap();
+    let sweep = |seed: &str| {
+        let args = [
+            "sweep",
+            room,
+            "--material",
+            "glass",
+            "--vary",
+            "transmittance=0.7..0.8:0.1",
+            "--sensor",
+            "back",
+            "--date",
+            "2026-03-21",
+            "--time",
+            "10:00",
+            "--sky",
+            "overcast",
+            "--format",
+            "csv",
+            "--seed",
+            seed,
+        ];
+        let Run { code, out, err } = heliodon(&args, &scratch());
+        assert_eq!(code, 0, "{err}");
+        out
+    };
+    let (zero, one) = (sweep("0"), sweep("1"));
+    assert_eq!(zero.lines().count(), 3, "{zero}");
+    assert_eq!(zero.lines().next(), one.lines().next());
+    assert_ne!(zero, one, "another sample of the rays reads otherwise");
+    let Run { code, err, .. } = heliodon(&["annual", room, "--weather", "any.epw", "--seed", "abc"], &scratch());
+    assert_eq!(code, 2);
+    assert!(err.contains("--seed"), "{err}");
+}
+
 /// An hour whose Perez sky gendaylit refuses (a positive parameter b, the
 /// sun 0.5° up) is dark in `annual`, as `sensors` reads it then, and both
 /// say why in one line; `sweep` against that year says it too. Such an

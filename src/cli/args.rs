@@ -36,6 +36,26 @@ impl SceneCase {
     }
 }
 
+/// The flags of the commands that precompute a scene's light: its cache
+/// and which sample of its rays.
+#[derive(clap::Args, Debug, Clone)]
+pub struct LightArgs {
+    /// Neither read nor write the precomputation cache
+    #[arg(long)]
+    pub no_cache: bool,
+    /// Which Monte Carlo sample of the rays to draw (0, the default, or any
+    /// other): the readings' spread over a few seeds is their noise
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+impl LightArgs {
+    /// The light settings these flags ask for.
+    pub fn settings(&self) -> LightSettings {
+        LightSettings { seed: self.seed, ..Default::default() }
+    }
+}
+
 /// The sky flags shared by the commands that light a scene.
 #[derive(clap::Args, Debug, Clone)]
 pub struct SkyArgs {

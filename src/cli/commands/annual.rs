@@ -11,8 +11,8 @@ use crate::annual::{
     AnnualOptions, AnnualResult, HourlyReadings, Occupancy, ShadedModel, annual, missing_in_daylight_note, skipped_hours_note,
 };
 use crate::cli::CliError;
-use crate::cli::args::{Format, load_for_command, precompute_for_command, progress_bar};
-use crate::light::{LightSettings, cache};
+use crate::cli::args::{Format, LightArgs, load_for_command, precompute_for_command, progress_bar};
+use crate::light::cache;
 use crate::panel::PanelCatalog;
 use crate::report::{csv_field, json_string};
 use crate::site::Site;
@@ -36,14 +36,13 @@ pub struct AnnualArgs {
     /// Ignore the scene's [[shades]]: every hour with the windows as modelled
     #[arg(long)]
     pub no_shades: bool,
-    /// Neither read nor write the precomputation cache
-    #[arg(long)]
-    pub no_cache: bool,
+    #[command(flatten)]
+    pub light: LightArgs,
 }
 
 /// Runs the year and prints the per-sensor metrics.
 pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
-    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels, args.no_cache)?);
+    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels, args.light.no_cache)?);
     if scene.sensors.is_empty() {
         return Err(CliError::failure(format!(
             "{}: the scene has no sensors; an annual study reads sensors ([[sensors]] or [[sensor_grids]])",
@@ -54,13 +53,13 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     let site = &scene.site;
     warn_about_weather(&args.weather, &weather, site);
 
-    let settings = LightSettings::default();
-    let model = precompute_for_command(scene.clone(), settings, args.no_cache)?;
-    let shaded = |down: &[usize]| precompute_for_command(std::sync::Arc::new(scene.with_shades_down(down)), settings, args.no_cache);
+    let settings = args.light.settings();
+    let model = precompute_for_command(scene.clone(), settings, args.light.no_cache)?;
+    let shaded = |down: &[usize]| precompute_for_command(std::sync::Arc::new(scene.with_shades_down(down)), settings, args.light.no_cache);
     let shades: Option<ShadedModel> = (!scene.shades.is_empty() && !args.no_shades).then_some(&shaded);
     // The year's sun at the site: traced once, then from the cache for every
     // weather file (unless its table would not fit in memory: then hour by hour).
-    let cache_dir = if args.no_cache { None } else { cache::default_dir() };
+    let cache_dir = if args.light.no_cache { None } else { cache::default_dir() };
     let hourly_csv = args.hourly.as_deref().map(|path| HourlyCsv::create(path, &scene, &weather)).transpose()?;
     let write_hour = |k: usize, values: &[f32]| hourly_csv.as_ref().map_or(Ok(()), |csv| csv.row(k, values));
     let progress = progress_bar("the year's sun, then a year of hours");

@@ -5,8 +5,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use crate::cli::CliError;
-use crate::cli::args::{Format, SkyArgs, load_for_command, precompute_for_command, sky_for};
-use crate::light::{LightSettings, Lighting};
+use crate::cli::args::{Format, LightArgs, SkyArgs, load_for_command, precompute_for_command, sky_for};
+use crate::light::Lighting;
 use crate::panel::PanelCatalog;
 use crate::report::{csv_field, json_string};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
@@ -25,13 +25,8 @@ pub struct SensorsArgs {
     pub sky: SkyArgs,
     #[arg(long, value_enum, default_value_t = Format::Table)]
     pub format: Format,
-    /// Neither read nor write the precomputation cache
-    #[arg(long)]
-    pub no_cache: bool,
-    /// Which Monte Carlo sample of the rays to draw (0, the default, or any
-    /// other): the readings' spread over a few seeds is their noise
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    #[command(flatten)]
+    pub light: LightArgs,
 }
 
 /// Prints the readings.
@@ -43,9 +38,8 @@ pub fn run(args: &SensorsArgs, panels: &PanelCatalog) -> Result<(), CliError> {
 /// The `sensors` command: one precomputation, then every date × time.
 pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, String> {
     let spec = args.sky.spec()?;
-    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels, args.no_cache)?);
-    let settings = LightSettings { seed: args.seed, ..Default::default() };
-    let model = precompute_for_command(scene.clone(), settings, args.no_cache)?;
+    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels, args.light.no_cache)?);
+    let model = precompute_for_command(scene.clone(), args.light.settings(), args.light.no_cache)?;
     // Sensors in the open: outside every room, or a model without one.
     const OUTSIDE: f64 = 0.3;
     let outside: Vec<&str> =

@@ -8,9 +8,8 @@ use std::path::{Path, PathBuf};
 
 use crate::annual::{Occupancy, YearSkies};
 use crate::cli::CliError;
-use crate::cli::args::{Format, SkyArgs, load_for_command, precompute_for_command, progress_bar, sky_for};
+use crate::cli::args::{Format, LightArgs, SkyArgs, load_for_command, precompute_for_command, progress_bar, sky_for};
 use crate::cli::sweep_table::{Row, SDA_ROW, Table, best, key_value};
-use crate::light::LightSettings;
 use crate::panel::PanelCatalog;
 use crate::report::{csv_field, json_string};
 use crate::sweep::{Axis, Grid, MAX_AXES, Target, Variation, parse_shard, sweep};
@@ -59,9 +58,8 @@ pub struct SweepArgs {
     /// Compute only part K of N equal parts (K from 1), to join with sweep-merge
     #[arg(long, value_name = "K/N", value_parser = parse_shard)]
     pub shard: Option<(usize, usize)>,
-    /// Neither read nor write the precomputation cache
-    #[arg(long)]
-    pub no_cache: bool,
+    #[command(flatten)]
+    pub light: LightArgs,
 }
 
 #[derive(clap::Args, Debug)]
@@ -84,7 +82,7 @@ pub fn run(args: &SweepArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     if args.weather.is_none() && args.date.is_none() {
         return Err(CliError::usage("a sweep needs an instant (--date and --time) or a year (--weather FILE.epw)"));
     }
-    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels, args.no_cache)?);
+    let scene = std::sync::Arc::new(load_for_command(&args.scene, panels, args.light.no_cache)?);
     let grid = Grid { axes: args.vary.clone() };
     let variation = Variation::new(&scene, &args.material, &grid, panels)?;
     let sensors: Vec<usize> = match &args.sensor {
@@ -124,7 +122,7 @@ pub fn run(args: &SweepArgs, panels: &PanelCatalog) -> Result<(), CliError> {
         Some((k, n)) => grid.shard(k, n),
         None => 0..grid.len(),
     };
-    let mut model = precompute_for_command(scene.clone(), LightSettings::default(), args.no_cache)?;
+    let mut model = precompute_for_command(scene.clone(), args.light.settings(), args.light.no_cache)?;
     let progress = progress_bar("sweeping");
     let outcomes = sweep(&mut model, &variation, &grid, range, &sensors, target, &|_, done| progress.set_position((done * 1000.0) as u64));
     progress.finish_and_clear();
