@@ -21,7 +21,6 @@ use super::bvh::Tracer;
 use super::gather::{Gather, SensorGeometry};
 use super::landings::Landings;
 use super::{LightModel, LightSettings};
-use crate::parallel::par_join;
 use crate::scene::{MaterialKind, Scene};
 use crate::sky::SkyPatches;
 
@@ -184,14 +183,7 @@ pub fn precompute_cached_beside(
 ) -> Result<(LightModel, CacheOutcome), String> {
     settings.check()?;
     let key = key(&scene, &settings);
-    let compute = || {
-        // The model (its shadow tracer, windows, openings) and the sides
-        // inside solids are made side by side.
-        let (empty, dark) =
-            par_join(settings.threads, || LightModel::empty(scene.clone(), settings, beside, None), || super::solids::dark_sides(&scene));
-        super::gather::check_memory(&scene, &settings)?;
-        Ok::<_, String>(empty.gathered(&dark, beside, progress))
-    };
+    let compute = || LightModel::traced(scene.clone(), settings, beside, progress);
     let (model, outcome) = match dir {
         None => (compute()?, CacheOutcome::Skipped("disabled".into())),
         Some(dir) => {
