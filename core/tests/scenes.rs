@@ -308,6 +308,22 @@ fn unregistered_panel() {
     // With panels registered, see app/tests/panels.rs.
 }
 
+/// A vertex that is not three numbers is named by its line (the
+/// vertices are checked beside tobj's reading, and their error wins).
+#[test]
+fn malformed_vertices_name_their_line() {
+    for (name, vertex, message) in [
+        ("two", "v 1 0", "vertex needs three coordinates"),
+        ("bare", "v", "vertex needs three coordinates"),
+        ("word", "v 1 x 0", "vertex coordinate 'x' is not a number"),
+    ] {
+        let f = fixture(name, &scene_toml(""), &OBJ.replace("v 1 0 0", vertex));
+        let e = f.error();
+        assert_eq!((e.location.file.clone(), e.location.line), (f.dir.join("room.obj"), Some(3)), "{e}");
+        assert_eq!(e.message, message);
+    }
+}
+
 #[test]
 fn non_finite_coordinates() {
     let f = fixture("nan", &scene_toml(""), &OBJ.replace("v 1 1 0", "v 1 nan 0"));

@@ -254,7 +254,7 @@ pub(crate) async fn build_model(
     panels: &PanelCatalog,
     reader: &mut impl SceneReader,
 ) -> Result<(BuiltModel, Vec<(PathBuf, String)>), SceneError> {
-    let obj_scan = obj::scan(obj_path, obj_text)?;
+    let obj_scan = obj::scan(obj_text);
     let mut mtls = Vec::new();
     for library in &obj_scan.material_libraries {
         let path = obj_path.parent().unwrap_or(Path::new("")).join(&library.name);
@@ -311,7 +311,11 @@ fn build(
     panels: &PanelCatalog,
 ) -> Result<BuiltModel, SceneError> {
     let mut warnings = Vec::new();
-    let model = obj::import(obj_path, obj_text, &obj_scan, mtls)?;
+    // The vertices are checked beside tobj's reading; a bad one is what the user hears of.
+    let (checked, model) =
+        crate::parallel::par_join(None, || obj::check(obj_path, obj_text, &obj_scan), || obj::import(obj_path, obj_text, &obj_scan, mtls));
+    checked?;
+    let model = model?;
     let (materials, material_of, unused_materials) = material::resolve(parsed, &model, panels, obj_path, &mut warnings)?;
     // A model in survey coordinates is recentred, in f64, before anything
     // becomes f32 (which keeps millimetres only within a few km of 0).

@@ -30,54 +30,55 @@ pub struct ObjScan {
     pub face_count: usize,
 }
 
-/// Scans OBJ text for references and faces, and rejects vertices that are not
-/// three finite numbers.
-pub fn scan(path: &Path, text: &str) -> Result<ObjScan, SceneError> {
+/// Scans OBJ text for references and faces (what reading the model needs
+/// before tobj: its MTL libraries and the material names it uses).
+pub fn scan(text: &str) -> ObjScan {
     let mut scan = ObjScan::default();
     for (index, line) in text.lines().enumerate() {
-        let line_no = index + 1;
         let line = line.trim();
         let (keyword, rest) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
         let rest = rest.trim();
         match keyword {
-            "v" => {
-                let coordinates: Vec<&str> = rest.split_whitespace().collect();
-                if coordinates.len() < 3 {
-                    return Err(SceneError::new(Location::line(path, line_no), "vertex needs three coordinates"));
-                }
-                for c in &coordinates[..3] {
-                    match c.parse::<f64>() {
-                        Ok(v) if v.is_finite() && v.abs() <= MAX_COORDINATE => {}
-                        Ok(v) if v.is_finite() => {
-                            return Err(SceneError::new(
-                                Location::line(path, line_no),
-                                format!("vertex coordinate {c} is beyond ±{MAX_COORDINATE:e} model units"),
-                            ));
-                        }
-                        Ok(_) => {
-                            return Err(SceneError::new(
-                                Location::line(path, line_no),
-                                format!("vertex has a non-finite coordinate '{c}'"),
-                            ));
-                        }
-                        Err(_) => {
-                            return Err(SceneError::new(Location::line(path, line_no), format!("vertex coordinate '{c}' is not a number")));
-                        }
-                    }
-                }
-            }
             "f" => scan.face_count += 1,
-            "mtllib" if !rest.is_empty() => scan.material_libraries.push(Reference { line: line_no, name: rest.to_string() }),
+            "mtllib" if !rest.is_empty() => scan.material_libraries.push(Reference { line: index + 1, name: rest.to_string() }),
             "usemtl" if !rest.is_empty() && !scan.used_materials.iter().any(|r| r.name == rest) => {
-                scan.used_materials.push(Reference { line: line_no, name: rest.to_string() });
+                scan.used_materials.push(Reference { line: index + 1, name: rest.to_string() });
             }
             _ => {}
+        }
+    }
+    scan
+}
+
+/// Rejects vertices that are not three finite numbers within
+/// [`MAX_COORDINATE`], and a model without faces: one error naming the line.
+/// (Apart from [`scan`], so that it runs beside tobj: parsing the numbers
+/// is most of a pass over a large OBJ.)
+pub fn check(path: &Path, text: &str, scan: &ObjScan) -> Result<(), SceneError> {
+    for (index, line) in text.lines().enumerate() {
+        let Some(rest) = line.trim().strip_prefix('v').filter(|rest| rest.is_empty() || rest.starts_with(char::is_whitespace)) else {
+            continue;
+        };
+        let at = || Location::line(path, index + 1);
+        let coordinates: Vec<&str> = rest.split_whitespace().collect();
+        if coordinates.len() < 3 {
+            return Err(SceneError::new(at(), "vertex needs three coordinates"));
+        }
+        for c in &coordinates[..3] {
+            match c.parse::<f64>() {
+                Ok(v) if v.is_finite() && v.abs() <= MAX_COORDINATE => {}
+                Ok(v) if v.is_finite() => {
+                    return Err(SceneError::new(at(), format!("vertex coordinate {c} is beyond ±{MAX_COORDINATE:e} model units")));
+                }
+                Ok(_) => return Err(SceneError::new(at(), format!("vertex has a non-finite coordinate '{c}'"))),
+                Err(_) => return Err(SceneError::new(at(), format!("vertex coordinate '{c}' is not a number"))),
+            }
         }
     }
     if scan.face_count == 0 {
         return Err(SceneError::new(Location::file(path), "the model has no faces"));
     }
-    Ok(scan)
+    Ok(())
 }
 
 /// The model as tobj read it, with every material name it uses.
