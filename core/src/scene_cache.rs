@@ -1,7 +1,7 @@
 //! The loaded model on disk. On a large model most of a warm `sensors` run
 //! was the load, not the light: the furnished floor of offices (31 MB of
 //! OBJ, 281k triangles) spent 0.6 of its 0.9 s parsing, grouping and
-//! cutting patches. So what [`scene::build_model`](crate::scene) makes of
+//! cutting patches. So what `scene::build_model` makes of
 //! the model's files (materials, triangles, surfaces, windows, patches and
 //! the warnings on the way) is stored beside the light cache
 //! (`light-scene-{key}.bin`, the same folder, bound and atomic writes),

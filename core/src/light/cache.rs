@@ -742,10 +742,9 @@ impl LightModel {
         let mut w = Writer::default();
         // The shadow tracer first, its length before it: a model beside
         // another skips it (it shares the other's).
-        let mut tracer = Writer::default();
-        self.shadow_tracer.write(&mut tracer);
-        w.u64(tracer.0.len() as u64);
-        w.0.extend_from_slice(&tracer.0);
+        let tracer = self.shadow_tracer.to_bytes();
+        w.u64(tracer.len() as u64);
+        w.0.extend_from_slice(&tracer);
         w.u32(self.side_gathers.len() as u32);
         self.side_gathers.iter().for_each(|g| w.gather(g));
         w.u32(self.sensors.len() as u32);
@@ -763,8 +762,7 @@ impl LightModel {
             Some(beside) => beside.shadow_tracer.clone(),
             None => {
                 let (triangles, owner) = LightModel::shadow_casters(scene);
-                let mut r = Reader(tracer_bytes);
-                Arc::new(Tracer::read(&mut r, &triangles, &owner).filter(|_| r.is_empty())?)
+                Arc::new(Tracer::from_bytes(tracer_bytes, &triangles, &owner)?)
             }
         };
         let (side_gathers, sensors) = Self::read_payload(scene, settings, rest)?;

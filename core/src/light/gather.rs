@@ -16,7 +16,7 @@ use glam::DVec3;
 use super::bvh::Tracer;
 use super::landings::Landings;
 use super::sampling::{self, Rng, cosine_directions, sample_area, with_cumulative_areas};
-use super::{LightModel, LightSettings, MAX_GLASS_DEPTH, MIN_WEIGHT, SURFACE_OFFSET, Surface, par_map};
+use super::{LightModel, LightSettings, MAX_GLASS_DEPTH, MIN_WEIGHT, SURFACE_OFFSET, Surface, par_map, side_of};
 use crate::parallel::par_join;
 use crate::scene::{Scene, Sensor};
 
@@ -224,11 +224,6 @@ impl Gather {
         };
         Self { daylight_coefficients: merge(&mut coefficients), form_factors: merge(&mut sides) }
     }
-}
-
-/// A patch side: index `2·patch` for the side its normal points to, `2·patch + 1` for the other.
-pub fn side_of(patch: u32, back: bool) -> u32 {
-    2 * patch + u32::from(back)
 }
 
 /// What a sensor sees, gathered once.

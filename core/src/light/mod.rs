@@ -53,7 +53,7 @@ use std::sync::Arc;
 use glam::DVec3;
 
 pub use coefficients::{SensorCoefficients, SunPath};
-pub use gather::{Gather, SkyKey, sensor_points, side_of};
+pub use gather::{Gather, SkyKey, sensor_points};
 pub use glass::Glass;
 pub use lobe_table::{LOBE_STEP, LobeTable, Sunlit};
 pub use measured::MeasuredSun;
@@ -62,6 +62,11 @@ pub use settings::LightSettings;
 pub use solver::{Interreflection, Relight, form_factor_product};
 pub use totals::{HourLight, HourSky, KnownSky, SkyBesidePanels, TotalCoefficients};
 pub use windows::{WindowGroup, WindowGroups};
+
+/// A patch side: index `2·patch` for the side its normal points to, `2·patch + 1` for the other.
+pub fn side_of(patch: u32, back: bool) -> u32 {
+    2 * patch + u32::from(back)
+}
 
 use crate::parallel::par_map;
 use crate::scene::{MaterialKind, Scene};

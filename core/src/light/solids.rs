@@ -12,7 +12,7 @@
 
 use glam::DVec3;
 
-use super::gather::side_of;
+use super::side_of;
 use crate::scene::shells::{Edges, Shells, model_shells, winding_number};
 use crate::scene::{MaterialKind, Scene};
 

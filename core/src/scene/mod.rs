@@ -1,7 +1,9 @@
 //! Scene loading: a scene file (TOML) with its OBJ and MTL turned into the
 //! geometry, materials, windows, patches and sensors every other part of
-//! heliodon works on. Plain Rust, no Bevy types: the Bevy asset loader, the
-//! CLI and the tests all go through [`load_scene_with`].
+//! heliodon works on. Plain Rust, no Bevy types: the Bevy asset loader and
+//! the tests go through [`load_scene_with`], the CLI through
+//! [`crate::scene_cache`], which keeps what `build_model` makes of the
+//! model's files (`BuiltModel`) and assembles the rest each time.
 //!
 //! Everything is in one canonical frame: metres, x east, y north, z up (as in
 //! Radiance). [`ModelFrame`] maps the model's own axes, north and units into it.
