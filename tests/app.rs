@@ -4,7 +4,7 @@
 #[path = "support/quick_light.rs"]
 mod quick_light;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use bevy::prelude::*;
@@ -437,6 +437,37 @@ fn the_sun_and_sky_follow_the_clock_once_per_change() {
     app.update();
     assert_eq!(messages(&mut app), 1);
     assert!(app.world().resource::<SunSky>().sky.sun.is_none());
+}
+
+/// The scene loader keeps what it makes of the model's files in the light
+/// cache's folder: a second app opening the scene reads that file (the same
+/// file, not one written again) and gets the same scene.
+#[test]
+fn opening_a_scene_goes_through_the_scene_cache() {
+    use heliodon::ecs::LightCacheDir;
+    use std::os::unix::fs::MetadataExt;
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("app_scene_cache");
+    let _ = std::fs::remove_dir_all(&dir);
+    let scene_files = || -> Vec<PathBuf> {
+        std::fs::read_dir(&dir)
+            .map(|entries| entries.flatten().map(|e| e.path()).filter(|p| p.to_string_lossy().contains("light-scene-")).collect())
+            .unwrap_or_default()
+    };
+    let opened = || {
+        let mut app = headless_app();
+        app.insert_resource(LightCacheDir(Some(dir.clone())));
+        open(&mut app, heliodon::bundled_scene("office")).unwrap();
+        let scene = app.world().resource::<ActiveScene>().loaded.clone().expect("loaded scene");
+        format!("{:?}", (&scene.triangles, &scene.surfaces, &scene.patches, &scene.sensors, &scene.materials))
+    };
+    let first = opened();
+    let files = scene_files();
+    assert_eq!(files.len(), 1, "{files:?}");
+    let inode = std::fs::metadata(&files[0]).unwrap().ino();
+    let second = opened();
+    assert_eq!(scene_files(), files);
+    assert_eq!(std::fs::metadata(&files[0]).unwrap().ino(), inode, "read, not written again");
+    assert_eq!(first, second);
 }
 
 /// A headless app with a quick light engine and no cache, with the bundled

@@ -11,6 +11,7 @@ use bevy::prelude::*;
 
 use crate::panel::{PanelCatalog, PanelType};
 use crate::scene::{self, Scene, SceneError, SceneReader, SceneWarning};
+use crate::scene_cache;
 
 /// A loaded scene file with its warnings.
 #[derive(Asset, TypePath, Debug, Clone)]
@@ -76,12 +77,27 @@ impl FromWorld for SceneLoader {
     }
 }
 
+/// How [`SceneLoader`] reads a scene: the folder where it keeps what the
+/// load makes of the model's files (the scene cache, beside the light
+/// cache: [`crate::scene_cache`]); `None`, the default, keeps nothing.
+/// The scene plugin hands it the [`super::LightCacheDir`] of the moment.
+#[derive(Debug, Default, Clone, serde::Serialize, serde::Deserialize)]
+pub struct SceneLoaderSettings {
+    /// The cache folder.
+    pub cache_dir: Option<PathBuf>,
+}
+
 impl AssetLoader for SceneLoader {
     type Asset = SceneAsset;
-    type Settings = ();
+    type Settings = SceneLoaderSettings;
     type Error = SceneError;
 
-    async fn load(&self, reader: &mut dyn Reader, _settings: &(), load_context: &mut LoadContext<'_>) -> Result<SceneAsset, SceneError> {
+    async fn load(
+        &self,
+        reader: &mut dyn Reader,
+        settings: &SceneLoaderSettings,
+        load_context: &mut LoadContext<'_>,
+    ) -> Result<SceneAsset, SceneError> {
         let scene_path = load_context.path().path().to_path_buf();
         let mut scene_bytes = Vec::new();
         reader
@@ -89,7 +105,8 @@ impl AssetLoader for SceneLoader {
             .await
             .map_err(|e| SceneError::new(scene::Location::file(&scene_path), format!("cannot read scene file: {e}")))?;
         let mut files = AssetFiles { context: load_context, first: Some((scene_path.clone(), scene_bytes)) };
-        let loaded = scene::load_scene_with(&scene_path, &self.panels.catalog(), &mut files).await?;
+        let (loaded, _) =
+            scene_cache::load_scene_cached_with(&scene_path, &self.panels.catalog(), &mut files, settings.cache_dir.as_deref()).await?;
         for warning in &loaded.warnings {
             warn!("{warning}");
         }

@@ -11,8 +11,8 @@ use std::sync::Arc;
 use bevy::asset::AssetLoadFailedEvent;
 use bevy::prelude::*;
 
-use super::scene_asset::{SceneAsset, SceneLoader, describe_load_failure, scene_asset_path};
-use super::{HeliodonSystems, PanelRegistry};
+use super::scene_asset::{SceneAsset, SceneLoader, SceneLoaderSettings, describe_load_failure, scene_asset_path};
+use super::{HeliodonSystems, LightCacheDir, PanelRegistry};
 use crate::light::LightModel;
 use crate::scene::{self, Scene};
 
@@ -179,9 +179,20 @@ pub struct SceneWindow {
 #[derive(Component, Debug, Clone)]
 pub struct SceneSensor(pub scene::Sensor);
 
-fn request_scene(mut requests: MessageReader<OpenScene>, asset_server: Res<AssetServer>, mut active: ResMut<ActiveScene>) {
+/// Starts loading the scene last asked for, through the scene cache in the
+/// light cache's folder (where there is one).
+fn request_scene(
+    mut requests: MessageReader<OpenScene>,
+    asset_server: Res<AssetServer>,
+    cache_dir: Option<Res<LightCacheDir>>,
+    mut active: ResMut<ActiveScene>,
+) {
     if let Some(OpenScene(path)) = requests.read().last() {
-        let handle = asset_server.load(scene_asset_path(path));
+        let cache_dir = cache_dir.and_then(|dir| dir.0.clone());
+        let handle = asset_server
+            .load_builder()
+            .with_settings(move |settings: &mut SceneLoaderSettings| settings.cache_dir.clone_from(&cache_dir))
+            .load(scene_asset_path(path));
         active.pending = Some((path.clone(), handle));
     }
 }
