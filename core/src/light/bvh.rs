@@ -268,6 +268,22 @@ mod tests {
         assert!(tracer.closest(DVec3::new(0.0, 0.0, 0.5), DVec3::Z, 0.0).is_none());
     }
 
+    /// `count` triangles, each with its centre drawn in the box `(lo, hi)`
+    /// and its corners within `half` of it on each axis.
+    fn random_triangles(
+        random: &mut impl FnMut(f64, f64) -> f64,
+        count: usize,
+        (lo, hi): ([f64; 3], [f64; 3]),
+        half: f64,
+    ) -> Vec<[Vec3; 3]> {
+        (0..count)
+            .map(|_| {
+                let centre = DVec3::new(random(lo[0], hi[0]), random(lo[1], hi[1]), random(lo[2], hi[2]));
+                [0, 1, 2].map(|_| (centre + DVec3::new(random(-half, half), random(-half, half), random(-half, half))).as_vec3())
+            })
+            .collect()
+    }
+
     /// Rays of one direction from anywhere in a box meet the same surfaces at
     /// the same distances whether they traverse the BVH or test the box's
     /// parallel hits: 400 random triangles, boxes from a point to 3 m wide,
@@ -277,12 +293,7 @@ mod tests {
         use crate::light::sampling::Rng;
         let mut rng = Rng::new(11, 0);
         let mut random = |lo: f64, hi: f64| lo + (hi - lo) * rng.next_f64();
-        let triangles: Vec<[Vec3; 3]> = (0..400)
-            .map(|_| {
-                let centre = DVec3::new(random(-10.0, 10.0), random(-10.0, 10.0), random(0.0, 10.0));
-                [0, 1, 2].map(|_| (centre + DVec3::new(random(-2.0, 2.0), random(-2.0, 2.0), random(-2.0, 2.0))).as_vec3())
-            })
-            .collect();
+        let triangles = random_triangles(&mut random, 400, ([-10.0, -10.0, 0.0], [10.0; 3]), 2.0);
         let owner: Vec<u32> = (0..400).map(|k| k / 3).collect();
         let tracer = Tracer::over(&triangles, owner);
         let (mut rays, mut met) = (0, 0);
@@ -328,12 +339,7 @@ mod tests {
         use crate::light::sampling::Rng;
         let mut rng = Rng::new(12, 0);
         let mut random = |lo: f64, hi: f64| lo + (hi - lo) * rng.next_f64();
-        let triangles: Vec<[Vec3; 3]> = (0..300)
-            .map(|_| {
-                let centre = DVec3::new(random(-5.0, 5.0), random(-5.0, 5.0), random(-5.0, 5.0));
-                [0, 1, 2].map(|_| (centre + DVec3::new(random(-1.0, 1.0), random(-1.0, 1.0), random(-1.0, 1.0))).as_vec3())
-            })
-            .collect();
+        let triangles = random_triangles(&mut random, 300, ([-5.0; 3], [5.0; 3]), 1.0);
         let owner: Vec<u32> = (0..300).map(|k| k / 2).collect();
         let built = Tracer::over(&triangles, owner.clone());
         let bytes = built.to_bytes();

@@ -183,28 +183,14 @@ pub fn precompute_cached_beside(
 ) -> Result<(LightModel, CacheOutcome), String> {
     settings.check()?;
     let key = key(&scene, &settings);
-    let compute = || LightModel::traced(scene.clone(), settings, beside, progress);
-    let (model, outcome) = match dir {
-        None => (compute()?, CacheOutcome::Skipped("disabled".into())),
-        Some(dir) => {
-            let (path, found) = open_entry(dir, &file_name(key), key);
-            let rebuilt = match found {
-                None => None,
-                Some(Err(why)) => Some(why),
-                Some(Ok(payload)) => match LightModel::read_cached(&scene, settings, beside, &payload) {
-                    Some(model) => {
-                        mark_used(&path);
-                        model.cache_key.get_or_init(|| key);
-                        return Ok((model, CacheOutcome::Hit(path)));
-                    }
-                    None => Some(DOES_NOT_FIT.to_string()),
-                },
-            };
-            let model = compute()?;
-            let outcome = store_entry(dir, path, key, &model.payload(), rebuilt);
-            (model, outcome)
-        }
-    };
+    let (model, outcome) = through_cache(
+        dir,
+        &file_name(key),
+        key,
+        |payload| LightModel::read_cached(&scene, settings, beside, payload),
+        || LightModel::traced(scene.clone(), settings, beside, progress),
+        LightModel::payload,
+    )?;
     model.cache_key.get_or_init(|| key);
     Ok((model, outcome))
 }
@@ -758,15 +744,16 @@ impl LightModel {
         let mut r = Reader(payload);
         let tracer_len = usize::try_from(r.u64()?).ok().filter(|&n| n <= r.0.len())?;
         let (tracer_bytes, rest) = r.0.split_at(tracer_len);
-        let shadow_tracer = match beside.filter(|b| Arc::ptr_eq(&b.scene, scene)) {
-            Some(beside) => beside.shadow_tracer.clone(),
-            None => {
-                let (triangles, owner) = LightModel::shadow_casters(scene);
-                Arc::new(Tracer::from_bytes(tracer_bytes, &triangles, &owner)?)
-            }
+        // A model beside of the same scene lends its shadow tracer (`empty`
+        // takes it); else the stored one is read.
+        let stored = if beside.is_some_and(|b| Arc::ptr_eq(&b.scene, scene)) {
+            None
+        } else {
+            let (triangles, owner) = LightModel::shadow_casters(scene);
+            Some(Arc::new(Tracer::from_bytes(tracer_bytes, &triangles, &owner)?))
         };
         let (side_gathers, sensors) = Self::read_payload(scene, settings, rest)?;
-        let empty = Self::empty(scene.clone(), settings, beside, Some(shadow_tracer));
+        let empty = Self::empty(scene.clone(), settings, beside, stored);
         Some(LightModel { side_gathers, sensors, ..empty }.sharing(beside))
     }
 
