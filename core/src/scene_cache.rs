@@ -17,13 +17,11 @@
 //! parameters (a panel's data files are not part of the key).
 
 use std::collections::BTreeMap;
-use std::hash::Hasher;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use rustc_hash::FxHasher;
 
-use crate::light::cache::{CacheOutcome, DOES_NOT_FIT, Fnv, Reader, Writer, mark_used, open_entry, store_entry};
+use crate::light::cache::{CacheOutcome, DOES_NOT_FIT, Reader, StableHash, Writer, mark_used, open_entry, store_entry};
 use crate::panel::{PanelCatalog, PanelHandle, Parameters, base_dir as panel_base_dir};
 use crate::scene::{
     self, BuiltModel, FsReader, LoadedScene, Location, Material, MaterialKind, MaterialOrigin, Patch, PatchMesh, Rgb, SceneError,
@@ -86,10 +84,8 @@ pub async fn load_scene_cached_with(
 }
 
 /// The scene file's path and bytes, the OBJ's, and the loader's version.
-/// Hashed eight bytes at a time (FxHash, not FNV's one): a large OBJ is
-/// tens of megabytes.
 fn key(scene_path: &Path, scene_text: &str, obj_text: &str) -> u64 {
-    let mut hash = FxHasher::default();
+    let mut hash = StableHash::new();
     let loader = [
         b"HELIOSC\0".as_slice(),
         &FORMAT.to_le_bytes(),
@@ -98,14 +94,13 @@ fn key(scene_path: &Path, scene_text: &str, obj_text: &str) -> u64 {
     ];
     // Lengths first, so no two different lists hash the same bytes.
     for part in loader.into_iter().chain([scene_path.as_os_str().as_encoded_bytes(), scene_text.as_bytes(), obj_text.as_bytes()]) {
-        hash.write_u64(part.len() as u64);
-        hash.write(part);
+        hash.u64(part.len() as u64).bytes(part);
     }
     hash.finish()
 }
 
 fn library_hash(text: &str) -> u64 {
-    Fnv::new().bytes(text.as_bytes()).0
+    StableHash::new().bytes(text.as_bytes()).finish()
 }
 
 /// Whether each MTL library still reads as it did.

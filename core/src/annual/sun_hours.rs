@@ -29,7 +29,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use glam::DVec3;
 
 use super::hour_time;
-use crate::light::cache::{self, CacheOutcome, Fnv, StreamedReader, StreamedWriter};
+use crate::light::cache::{self, CacheOutcome, StableHash, StreamedReader, StreamedWriter};
 use crate::light::coefficients::SunResponse;
 use crate::light::{LightModel, SensorCoefficients, SunPath};
 use crate::parallel::par_map;
@@ -257,7 +257,7 @@ impl SunHours {
     /// ([`cache::key`]), every material's light, the site, the shade groups.
     pub fn key(model: &LightModel, site: &Site, shades: bool) -> u64 {
         let scene = &model.scene;
-        let mut hash = Fnv::new();
+        let mut hash = StableHash::new();
         hash.u64(model.cache_key()).u64(u64::from(FORMAT));
         for material in &scene.materials {
             match &material.kind {
@@ -278,7 +278,7 @@ impl SunHours {
                 hash.u64(u64::from(group.windows));
             }
         }
-        hash.0
+        hash.finish()
     }
 
     /// Whether the table was traced for this model at this site.

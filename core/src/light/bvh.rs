@@ -53,7 +53,11 @@ impl Tracer {
     /// [`Hit::patch`] (a surface, say).
     pub fn over(triangles: &[[glam::Vec3; 3]], owner: Vec<u32>) -> Self {
         let triangles = bvh_triangles(triangles);
-        let bvh = build_cwbvh_from_tris(&triangles, BvhBuildParams::medium_build(), &mut Duration::default());
+        // obvhs' fast build: a cold few-sensor run on a large model spends
+        // more on building the two BVHs than on the rays that the medium
+        // build's tighter tree would save (the furnished floor with 48
+        // sensors: about 5% faster, the same readings).
+        let bvh = build_cwbvh_from_tris(&triangles, BvhBuildParams::fast_build(), &mut Duration::default());
         Self::with_bvh(bvh, &triangles, &owner)
     }
 

@@ -36,7 +36,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::cache::{self, CacheOutcome, Fnv, Reader, Writer};
+use super::cache::{self, CacheOutcome, Reader, StableHash, Writer};
 use super::daylight::{KeyRadiance, RadianceSlots};
 use super::sun::SidesReach;
 use super::{LightModel, SensorReading, SunBeam, luminous, par_map};
@@ -150,7 +150,7 @@ impl LightModel {
         if (slots + sides) * sensors * size_of::<f32>() > MAX_CACHED_BYTES {
             return (self.sensor_coefficients(), CacheOutcome::Skipped("too large to keep".into()));
         }
-        let mut hash = Fnv::new();
+        let mut hash = StableHash::new();
         hash.u64(self.cache_key()).u64(u64::from(FORMAT));
         for side in 0..sides {
             match self.side_reflectance(side) {
@@ -158,7 +158,7 @@ impl LightModel {
                 None => hash.u64(0),
             };
         }
-        let key = hash.0;
+        let key = hash.finish();
         let stored = cache::through_cache(
             Some(dir),
             &format!("{key:016x}-coefficients"),

@@ -13,7 +13,7 @@
 use glam::DVec3;
 
 use super::side_of;
-use crate::scene::shells::{Edges, Shells, model_shells, winding_number};
+use crate::scene::shells::{Shells, model_shells, winding_number};
 use crate::scene::{MaterialKind, Scene};
 
 /// How far (m) from a window's face its inside is probed.
@@ -36,7 +36,7 @@ pub(super) fn dark_sides(scene: &Scene) -> Vec<bool> {
             vertices.push(triangle.file_vertices);
         }
     }
-    let mut shells = model_shells(&triangles, &Edges::by_points(&triangles), &vertices);
+    let (mut shells, _) = model_shells(&triangles, &vertices);
     open_shells_holding_windows(scene, &triangles, &mut shells, |material| !opaque(material));
     // Per surface: +1 where its shells' outside is the way its normal
     // points, −1 the other way, 0 where it is not wholly a shell's face.

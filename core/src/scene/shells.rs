@@ -32,9 +32,21 @@ pub(crate) struct Edges {
 }
 
 impl Edges {
-    /// Edges between points that are equal to the bit.
+    /// Edges between points that are equal to the bit. Each point is
+    /// numbered first, through a map: sorting the edges by their ends'
+    /// twelve-byte coordinates took twice as long on a large model.
     pub(crate) fn by_points(triangles: &[[Vec3; 3]]) -> Self {
-        Self::between(triangles.len(), |corner| triangles[corner / 3][corner % 3].to_array().map(f32::to_bits))
+        let mut numbers: rustc_hash::FxHashMap<[u32; 3], u32> = rustc_hash::FxHashMap::default();
+        numbers.reserve(triangles.len());
+        let corners: Vec<u32> = triangles
+            .iter()
+            .flatten()
+            .map(|p| {
+                let next = numbers.len() as u32;
+                *numbers.entry(p.to_array().map(f32::to_bits)).or_insert(next)
+            })
+            .collect();
+        Self::between(triangles.len(), |corner| corners[corner])
     }
 
     /// `corner(3t + k)` is corner k of triangle t, as something equal where
@@ -141,20 +153,26 @@ pub(crate) fn closed_shells(triangles: &[[Vec3; 3]], edges: &Edges) -> Shells {
     shells
 }
 
-/// [`closed_shells`] of a model's `triangles` (`by_points`: their
-/// [`Edges::by_points`]), with the vertices of its file each corner is
-/// (`vertices[t][k]`, equal numbers for one vertex): shells are found by
-/// those too, so a solid that touches another along an edge (a wall
-/// standing on a slab's edge: four faces meet there) is still a shell.
+/// [`closed_shells`] of a model's `triangles`, with the vertices of its
+/// file each corner is (`vertices[t][k]`, equal numbers for one vertex):
+/// shells are found by those too, so a solid that touches another along an
+/// edge (a wall standing on a slab's edge: four faces meet there) is still
+/// a shell. Returns the shells and the triangles' [`Edges::by_points`].
 ///
 /// Where points close a shell (a file of faces that share no vertices)
 /// that shell is kept; else the vertices' shells, which lie within one
 /// set of triangles joined by points, never across two: each shell found
-/// one way or the other is whole.
-pub(crate) fn model_shells(triangles: &[[Vec3; 3]], by_points: &Edges, vertices: &[[u32; 3]]) -> Shells {
+/// one way or the other is whole. The two ways are found side by side.
+pub(crate) fn model_shells(triangles: &[[Vec3; 3]], vertices: &[[u32; 3]]) -> (Shells, Edges) {
     debug_assert_eq!(triangles.len(), vertices.len());
-    let mut shells = closed_shells(triangles, by_points);
-    let by_vertices = closed_shells(triangles, &Edges::between(triangles.len(), |corner| vertices[corner / 3][corner % 3]));
+    let ((mut shells, by_points), by_vertices) = crate::parallel::par_join(
+        None,
+        || {
+            let by_points = Edges::by_points(triangles);
+            (closed_shells(triangles, &by_points), by_points)
+        },
+        || closed_shells(triangles, &Edges::between(triangles.len(), |corner| vertices[corner / 3][corner % 3])),
+    );
     let numbered_apart = triangles.len() as u32;
     for t in 0..triangles.len() {
         if shells.winding[t] != 0 || by_vertices.winding[t] == 0 {
@@ -163,7 +181,7 @@ pub(crate) fn model_shells(triangles: &[[Vec3; 3]], by_points: &Edges, vertices:
         shells.winding[t] = by_vertices.winding[t];
         shells.shell[t] = numbered_apart + by_vertices.shell[t];
     }
-    shells
+    (shells, by_points)
 }
 
 /// The solid angle triangle `t` fills seen from `eye`, positive where

@@ -91,9 +91,8 @@ impl Casters {
     /// standing on a slab's edge: four faces meet there) is still a shell;
     /// sides still cancel wherever points are equal ([`model_shells`]).
     pub fn of_model(triangles: Vec<[Vec3; 3]>, vertices: &[[u32; 3]]) -> Self {
-        let edges = Edges::by_points(&triangles);
-        let shell_winding = model_shells(&triangles, &edges, vertices).winding;
-        Self::with_shells(triangles, edges, shell_winding)
+        let (shells, edges) = model_shells(&triangles, vertices);
+        Self::with_shells(triangles, edges, shells.winding)
     }
 
     fn with_shells(triangles: Vec<[Vec3; 3]>, edges: Edges, shell_winding: Vec<i8>) -> Self {
