@@ -309,7 +309,7 @@ fn unregistered_panel() {
 }
 
 /// A vertex that is not three numbers is named by its line (the
-/// vertices are checked beside tobj's reading, and their error wins).
+/// OBJ reader names the first bad line).
 #[test]
 fn malformed_vertices_name_their_line() {
     for (name, vertex, message) in [

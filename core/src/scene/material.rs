@@ -89,11 +89,12 @@ pub struct Material {
 /// Reflectance of faces that name no material (with a warning).
 const UNASSIGNED_REFLECTANCE: f32 = 0.5;
 
-/// Materials in order, and each tobj material index's place among them.
+/// Materials in order, and each OBJ material index's place among them.
 pub type ResolvedMaterials = (Vec<Material>, BTreeMap<Option<usize>, u32>, BTreeMap<String, Material>);
 
-/// The materials the model's faces use, in order of tobj's index (faces with
-/// no material last), and each tobj index's place in that list; and the
+/// The materials the model's faces use, in order of their index in
+/// [`ObjModel::materials`] (faces with no material last), and each index's
+/// place in that list; and the
 /// `[materials]` no face uses, by name (shades draw them).
 pub fn resolve(
     parsed: &ParsedScene,
@@ -106,7 +107,15 @@ pub fn resolve(
     for (name, table) in &parsed.materials {
         scene_materials.insert(name.as_str(), scene_material(parsed, name, table, panels)?);
     }
-    let used: BTreeSet<Option<usize>> = model.meshes.iter().map(|m| m.mesh.material_id).collect();
+    let mut used: BTreeSet<Option<usize>> = BTreeSet::new();
+    let mut last = None;
+    for face in &model.faces {
+        // Faces come in runs of one material: each run inserted once.
+        if last != Some(face.material) {
+            used.insert(face.material);
+            last = Some(face.material);
+        }
+    }
     let used_names: BTreeSet<&str> = used.iter().flatten().map(|&i| model.materials[i].name.as_str()).collect();
     // Shade materials are drawn only when a shade is down (see `shades`).
     let shade_names: BTreeSet<&str> = parsed.shades.iter().map(|s| s.get_ref().shade.get_ref().as_str()).collect();
@@ -131,7 +140,7 @@ pub fn resolve(
                 }
             }
             None => {
-                let faces: usize = model.meshes.iter().filter(|m| m.mesh.material_id.is_none()).map(|m| m.mesh.indices.len() / 3).sum();
+                let faces: usize = model.faces.iter().filter(|f| f.material.is_none()).map(|f| f.corners.len() - 2).sum();
                 warnings.push(SceneWarning {
                     location: Location::file(obj_path),
                     message: format!(

@@ -313,11 +313,7 @@ fn build(
     panels: &PanelCatalog,
 ) -> Result<BuiltModel, SceneError> {
     let mut warnings = Vec::new();
-    // The vertices are checked beside tobj's reading; a bad one is what the user hears of.
-    let (checked, model) =
-        crate::parallel::par_join(None, || obj::check(obj_path, obj_text, &obj_scan), || obj::import(obj_path, obj_text, &obj_scan, mtls));
-    checked?;
-    let model = model?;
+    let model = obj::read(obj_path, obj_text, &obj_scan, mtls)?;
     let (materials, material_of, unused_materials) = material::resolve(parsed, &model, panels, obj_path, &mut warnings)?;
     // A model in survey coordinates is recentred, in f64, before anything
     // becomes f32 (which keeps millimetres only within a few km of 0).

@@ -1,11 +1,12 @@
-//! The OBJ model and its MTL libraries, read through tobj.
-//!
-//! tobj reports errors without line numbers and forgets the names of materials
-//! no MTL defines, so a light scan of the text comes first: it finds the
-//! material libraries, the `usemtl` names and bad vertices with their lines.
+//! The OBJ model and its MTL libraries. The OBJ is read here (vertices,
+//! faces, `usemtl`), in chunks side by side, every error naming its line;
+//! the MTL libraries through tobj. A light scan of the text comes first:
+//! it finds the material libraries to read and the `usemtl` names.
 
 use std::collections::{BTreeMap, HashMap};
+use std::hash::{Hash, Hasher};
 use std::io::Cursor;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use glam::{DVec3, Vec3};
@@ -13,6 +14,7 @@ use glam::{DVec3, Vec3};
 use super::error::{Location, SceneError, SceneWarning};
 use super::frame::ModelFrame;
 use super::{MAX_COORDINATE, Triangle, polygon};
+use crate::parallel::par_map;
 
 /// A `mtllib` or `usemtl` reference and the line it stands on.
 #[derive(Debug, Clone)]
@@ -31,7 +33,7 @@ pub struct ObjScan {
 }
 
 /// Scans OBJ text for references and faces (what reading the model needs
-/// before tobj: its MTL libraries and the material names it uses).
+/// first: its MTL libraries and the material names it uses).
 pub fn scan(text: &str) -> ObjScan {
     let mut scan = ObjScan::default();
     for (index, line) in text.lines().enumerate() {
@@ -50,45 +52,6 @@ pub fn scan(text: &str) -> ObjScan {
     scan
 }
 
-/// Rejects vertices that are not three finite numbers within
-/// [`MAX_COORDINATE`], and a model without faces: one error naming the line.
-/// (Apart from [`scan`], so that it runs beside tobj: parsing the numbers
-/// is most of a pass over a large OBJ.)
-pub fn check(path: &Path, text: &str, scan: &ObjScan) -> Result<(), SceneError> {
-    for (index, line) in text.lines().enumerate() {
-        let Some(rest) = line.trim().strip_prefix('v').filter(|rest| rest.is_empty() || rest.starts_with(char::is_whitespace)) else {
-            continue;
-        };
-        let at = || Location::line(path, index + 1);
-        let coordinates: Vec<&str> = rest.split_whitespace().collect();
-        if coordinates.len() < 3 {
-            return Err(SceneError::new(at(), "vertex needs three coordinates"));
-        }
-        for c in &coordinates[..3] {
-            match c.parse::<f64>() {
-                Ok(v) if v.is_finite() && v.abs() <= MAX_COORDINATE => {}
-                Ok(v) if v.is_finite() => {
-                    return Err(SceneError::new(at(), format!("vertex coordinate {c} is beyond ±{MAX_COORDINATE:e} model units")));
-                }
-                Ok(_) => return Err(SceneError::new(at(), format!("vertex has a non-finite coordinate '{c}'"))),
-                Err(_) => return Err(SceneError::new(at(), format!("vertex coordinate '{c}' is not a number"))),
-            }
-        }
-    }
-    if scan.face_count == 0 {
-        return Err(SceneError::new(Location::file(path), "the model has no faces"));
-    }
-    Ok(())
-}
-
-/// The model as tobj read it, with every material name it uses.
-pub struct ObjModel {
-    pub meshes: Vec<tobj::Model>,
-    /// tobj's materials by index: those of the MTL files, then one empty entry
-    /// for each `usemtl` name no MTL defines.
-    pub materials: Vec<MtlMaterial>,
-}
-
 pub struct MtlMaterial {
     pub name: String,
     /// The MTL definition, or `None` for a name only `usemtl` mentions.
@@ -96,10 +59,6 @@ pub struct MtlMaterial {
     /// Where the definition (or, for undefined names, the first use) is.
     pub location: Location,
 }
-
-/// Material library name that tobj is handed first: every material of every
-/// MTL goes through it, so `usemtl` resolves whatever the order of the lines.
-const ALL_MATERIALS: &str = "heliodon-all-materials.mtl";
 
 /// Runs a reader that may panic on input it does not expect (tobj 4 does,
 /// e.g. on `Ks 0`): `None` instead of a panic reaching the user.
@@ -140,8 +99,10 @@ fn check_mtl(path: &Path, text: &str) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// Reads the OBJ with tobj, triangulated, with materials from `mtls`.
-pub fn import(path: &Path, text: &str, scan: &ObjScan, mtls: &[(PathBuf, String)]) -> Result<ObjModel, SceneError> {
+/// The materials of the MTL libraries `mtls` (a later definition of a
+/// name replaces an earlier one), then those `usemtl` names that no
+/// library defines.
+fn materials(path: &Path, scan: &ObjScan, mtls: &[(PathBuf, String)]) -> Result<Vec<MtlMaterial>, SceneError> {
     let mut materials: Vec<MtlMaterial> = Vec::new();
     for (mtl_path, mtl_text) in mtls {
         check_mtl(mtl_path, mtl_text)?;
@@ -166,28 +127,283 @@ pub fn import(path: &Path, text: &str, scan: &ObjScan, mtls: &[(PathBuf, String)
             materials.push(MtlMaterial { name: used.name.clone(), definition: None, location: Location::line(path, used.line) });
         }
     }
-    let library: Vec<tobj::Material> = materials.iter().map(|m| tobj::Material { name: m.name.clone(), ..Default::default() }).collect();
-    let index: HashMap<String, usize> = materials.iter().enumerate().map(|(i, m)| (m.name.clone(), i)).collect();
-    let source = format!("mtllib {ALL_MATERIALS}\n{text}");
-    let options = tobj::LoadOptions { single_index: true, triangulate: false, ignore_points: true, ignore_lines: true };
-    let (meshes, _) = guarded(|| {
-        tobj::load_obj_buf(&mut Cursor::new(source.as_bytes()), &options, |library_path| {
-            if library_path == Path::new(ALL_MATERIALS) {
-                Ok((library.clone(), index.clone()))
-            } else {
-                // Real libraries were read above and are already in ALL_MATERIALS.
-                Ok((Vec::new(), HashMap::new()))
-            }
-        })
-    })
-    .ok_or_else(|| SceneError::new(Location::file(path), "cannot parse OBJ: the OBJ reader (tobj) failed on it"))?
-    .map_err(|error| SceneError::new(Location::file(path), format!("cannot parse OBJ: {error}")))?;
-    Ok(ObjModel { meshes, materials })
+    Ok(materials)
 }
 
-/// The model's triangles in the canonical frame, with tobj's material index
-/// (or `None` for faces before any `usemtl`). Degenerate triangles are dropped
-/// with a warning.
+/// A face's corners and material as the file writes them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObjFace {
+    /// Index into [`ObjModel::materials`]; `None` before any `usemtl`.
+    pub material: Option<usize>,
+    /// Range into [`ObjModel::corners`].
+    pub corners: Range<u32>,
+}
+
+/// One corner of a face.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Corner {
+    /// Index into [`ObjModel::positions`].
+    pub position: u32,
+    /// Which of the file's vertices it is ([`super::Triangle::file_vertices`]):
+    /// its position, texture and normal within one run of faces between
+    /// `o`, `g` and `usemtl` lines.
+    pub vertex: u32,
+}
+
+/// The model as its OBJ writes it, with every material name it uses.
+pub struct ObjModel {
+    /// The `v` lines, in model units.
+    pub positions: Vec<DVec3>,
+    /// The faces of three corners or more (points and lines are not
+    /// surfaces).
+    pub faces: Vec<ObjFace>,
+    pub corners: Vec<Corner>,
+    /// The materials by index: those of the MTL files, then one empty entry
+    /// for each `usemtl` name no MTL defines.
+    pub materials: Vec<MtlMaterial>,
+}
+
+/// An index of a face corner as written: from the start of the file
+/// (`k`, 1-based) or back from the element last read (`-k`).
+#[derive(Debug, Clone, Copy)]
+enum Written {
+    /// 0-based.
+    FromStart(u32),
+    /// How many such elements the chunk had read, and how far back.
+    Back { read: u32, back: u32 },
+}
+
+/// A face corner's three indices as written.
+#[derive(Debug, Clone, Copy)]
+struct WrittenCorner {
+    v: Written,
+    vt: Option<Written>,
+    vn: Option<Written>,
+}
+
+/// A face as a chunk read it.
+struct ChunkFace {
+    /// Its line in the chunk (0-based).
+    line: u32,
+    /// The run of faces it is in (0: the run the chunk began in).
+    run: u32,
+    /// Its material; `None`: as the chunk began.
+    material: Option<Option<usize>>,
+    /// Range into [`Chunk::corners`].
+    corners: Range<u32>,
+}
+
+/// What one chunk of the OBJ's lines holds, with indices and states that
+/// depend on the chunks before it left open.
+#[derive(Default)]
+struct Chunk {
+    lines: usize,
+    positions: Vec<DVec3>,
+    texcoords: u32,
+    normals: u32,
+    faces: Vec<ChunkFace>,
+    corners: Vec<WrittenCorner>,
+    /// The material of the chunk's last `usemtl`, if any.
+    last_material: Option<Option<usize>>,
+    /// How many runs of faces began in it.
+    runs: u32,
+    /// The first bad line: its number in the chunk (0-based) and why.
+    error: Option<(usize, String)>,
+}
+
+/// Chunks of about this many bytes are read side by side.
+const CHUNK_BYTES: usize = 1 << 20;
+
+/// Reads the OBJ's vertices and faces with materials from `mtls`: one
+/// error naming the line for a vertex that is not three finite numbers
+/// within [`MAX_COORDINATE`] or a face corner that names no vertex. Large
+/// files are read in chunks side by side (most of a load's time was
+/// parsing them); the result is the same however they are cut.
+pub fn read(path: &Path, text: &str, scan: &ObjScan, mtls: &[(PathBuf, String)]) -> Result<ObjModel, SceneError> {
+    read_in_chunks(path, text, scan, mtls, CHUNK_BYTES)
+}
+
+/// [`read`] in chunks of about `chunk_bytes`.
+fn read_in_chunks(path: &Path, text: &str, scan: &ObjScan, mtls: &[(PathBuf, String)], chunk_bytes: usize) -> Result<ObjModel, SceneError> {
+    let materials = materials(path, scan, mtls)?;
+    let index: HashMap<&str, usize> = materials.iter().enumerate().map(|(i, m)| (m.name.as_str(), i)).collect();
+    let pieces = chunks(text, chunk_bytes);
+    let chunks = par_map(None, pieces.len(), |k| read_chunk(pieces[k], &index));
+    if let Some((line, message)) = chunks
+        .iter()
+        .scan(0, |first, chunk| {
+            let at = *first;
+            *first += chunk.lines;
+            Some(chunk.error.as_ref().map(|(line, message)| (at + line + 1, message)))
+        })
+        .flatten()
+        .next()
+    {
+        return Err(SceneError::new(Location::line(path, line), message.clone()));
+    }
+    if scan.face_count == 0 {
+        return Err(SceneError::new(Location::file(path), "the model has no faces"));
+    }
+    join(path, chunks, materials)
+}
+
+/// The text cut into pieces of whole lines, about `bytes` each.
+fn chunks(text: &str, bytes: usize) -> Vec<&str> {
+    let mut pieces = Vec::new();
+    let mut rest = text;
+    while rest.len() > bytes {
+        // After a newline: a character's boundary, whatever comes before.
+        let cut = rest.as_bytes()[bytes..].iter().position(|&b| b == b'\n').map_or(rest.len(), |k| bytes + k + 1);
+        let (piece, after) = rest.split_at(cut);
+        pieces.push(piece);
+        rest = after;
+    }
+    pieces.push(rest);
+    pieces
+}
+
+/// A corner's index as written (`k` or `-k`, 1-based); `None` for 0 or
+/// what is not a whole number.
+fn written(word: &str, read: u32) -> Option<Written> {
+    let k: i64 = word.parse().ok()?;
+    match k {
+        1.. => Some(Written::FromStart(u32::try_from(k - 1).ok()?)),
+        ..0 => Some(Written::Back { read, back: u32::try_from(-k).ok()? }),
+        0 => None,
+    }
+}
+
+fn read_chunk(text: &str, materials: &HashMap<&str, usize>) -> Chunk {
+    let mut chunk = Chunk::default();
+    for (line_index, line) in text.lines().enumerate() {
+        chunk.lines += 1;
+        if chunk.error.is_some() {
+            continue;
+        }
+        let line = line.trim();
+        let (keyword, rest) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
+        let fail = |chunk: &mut Chunk, message: String| chunk.error = Some((line_index, message));
+        match keyword {
+            "v" => match vertex(rest) {
+                Ok(p) => chunk.positions.push(p),
+                Err(message) => fail(&mut chunk, message),
+            },
+            "vt" => chunk.texcoords += 1,
+            "vn" => chunk.normals += 1,
+            "f" => {
+                let start = chunk.corners.len() as u32;
+                let read = (chunk.positions.len() as u32, chunk.texcoords, chunk.normals);
+                for word in rest.split_whitespace().take_while(|w| !w.starts_with('#')) {
+                    let mut parts = word.split('/');
+                    let index = |part: Option<&str>, read: u32| part.filter(|p| !p.is_empty()).and_then(|p| written(p, read));
+                    let Some(v) = index(parts.next(), read.0) else {
+                        fail(&mut chunk, format!("face corner '{word}' names no vertex (expected v, v/vt, v//vn or v/vt/vn, 1-based)"));
+                        break;
+                    };
+                    chunk.corners.push(WrittenCorner { v, vt: index(parts.next(), read.1), vn: index(parts.next(), read.2) });
+                }
+                let end = chunk.corners.len() as u32;
+                if chunk.error.is_none() && end - start >= 3 {
+                    chunk.faces.push(ChunkFace {
+                        line: line_index as u32,
+                        run: chunk.runs,
+                        material: chunk.last_material,
+                        corners: start..end,
+                    });
+                } else {
+                    chunk.corners.truncate(start as usize);
+                }
+            }
+            "o" | "g" => chunk.runs += 1,
+            "usemtl" if !rest.trim().is_empty() => {
+                chunk.runs += 1;
+                chunk.last_material = Some(materials.get(rest.trim()).copied());
+            }
+            _ => {}
+        }
+    }
+    chunk
+}
+
+/// A `v` line's first three numbers (a fourth, w, or colours after them
+/// are not geometry).
+fn vertex(rest: &str) -> Result<DVec3, String> {
+    let mut coordinates = [0.0; 3];
+    let mut words = rest.split_whitespace();
+    for c in &mut coordinates {
+        let word = words.next().ok_or("vertex needs three coordinates")?;
+        *c = match word.parse::<f64>() {
+            Ok(v) if v.is_finite() && v.abs() <= MAX_COORDINATE => v,
+            Ok(v) if v.is_finite() => return Err(format!("vertex coordinate {word} is beyond ±{MAX_COORDINATE:e} model units")),
+            Ok(_) => return Err(format!("vertex has a non-finite coordinate '{word}'")),
+            Err(_) => return Err(format!("vertex coordinate '{word}' is not a number")),
+        };
+    }
+    Ok(DVec3::from_array(coordinates))
+}
+
+/// The chunks joined: indices made absolute, materials and runs carried
+/// over from the chunks before, the file's vertices numbered.
+fn join(path: &Path, chunks: Vec<Chunk>, materials: Vec<MtlMaterial>) -> Result<ObjModel, SceneError> {
+    let total = chunks.iter().map(|c| c.positions.len()).sum::<usize>();
+    let mut positions = Vec::with_capacity(total);
+    let mut faces = Vec::with_capacity(chunks.iter().map(|c| c.faces.len()).sum());
+    let mut corners = Vec::with_capacity(chunks.iter().map(|c| c.corners.len()).sum());
+    // Each file vertex (its position, texture and normal within a run of
+    // faces) numbered as first met. Runs end for good, so the map holds
+    // one run's: small, where a map of all the file's was most of a read.
+    let (mut numbers, mut numbered, mut current_run) = (rustc_hash::FxHashMap::<(u32, i64, i64), u32>::default(), 0u32, 0u32);
+    let (mut first_line, mut runs, mut material) = (0usize, 0u32, None);
+    let (mut texcoords, mut normals) = (0i64, 0i64);
+    for chunk in chunks {
+        let before = positions.len() as i64;
+        let absolute = |w: Written, before: i64| match w {
+            Written::FromStart(k) => i64::from(k),
+            Written::Back { read, back } => before + i64::from(read) - i64::from(back),
+        };
+        for face in &chunk.faces {
+            let face_material = face.material.unwrap_or(material);
+            let start = corners.len() as u32;
+            for written in &chunk.corners[face.corners.start as usize..face.corners.end as usize] {
+                let v = absolute(written.v, before);
+                let Some(position) = u32::try_from(v).ok().filter(|&v| (v as usize) < total) else {
+                    let message = if v < 0 {
+                        "face goes back past the file's first vertex".to_string()
+                    } else {
+                        format!("face names vertex {} but the file has {total} vertices", v + 1)
+                    };
+                    return Err(SceneError::new(Location::line(path, first_line + face.line as usize + 1), message));
+                };
+                let vt = written.vt.map_or(-1, |w| absolute(w, texcoords));
+                let vn = written.vn.map_or(-1, |w| absolute(w, normals));
+                if runs + face.run != current_run {
+                    current_run = runs + face.run;
+                    numbered += numbers.len() as u32;
+                    // A large run's table is not cleared bucket by bucket at every small one after it.
+                    if numbers.capacity() > 1024 {
+                        numbers = rustc_hash::FxHashMap::default();
+                    }
+                    numbers.clear();
+                }
+                let next = numbered + numbers.len() as u32;
+                let vertex = *numbers.entry((position, vt, vn)).or_insert(next);
+                corners.push(Corner { position, vertex });
+            }
+            faces.push(ObjFace { material: face_material, corners: start..corners.len() as u32 });
+        }
+        positions.extend(chunk.positions);
+        first_line += chunk.lines;
+        runs += chunk.runs;
+        material = chunk.last_material.unwrap_or(material);
+        texcoords += i64::from(chunk.texcoords);
+        normals += i64::from(chunk.normals);
+    }
+    Ok(ObjModel { positions, faces, corners, materials })
+}
+
+/// The model's triangles in the canonical frame, with the material index
+/// of their face (`None` for faces before any `usemtl`). Degenerate and
+/// duplicated triangles are dropped with a warning.
 pub fn triangles(
     model: &ObjModel,
     frame: &ModelFrame,
@@ -195,52 +411,60 @@ pub fn triangles(
     path: &Path,
     warnings: &mut Vec<SceneWarning>,
 ) -> Result<Vec<Triangle>, SceneError> {
-    let mut triangles = Vec::new();
-    let mut degenerate = 0usize;
-    // Faces written twice (same corners, same material) count once: copies
-    // would weigh on every ray and pass for nothing.
-    let mut seen: rustc_hash::FxHashSet<([[u32; 3]; 3], u32)> = rustc_hash::FxHashSet::default();
-    seen.reserve(model.meshes.iter().map(|m| m.mesh.indices.len() / 3).sum());
-    let mut duplicated = 0usize;
-    // tobj numbers each mesh's vertices from 0: numbered on across meshes.
-    let mut first_vertex = 0u32;
-    for model_mesh in &model.meshes {
-        let mesh = &model_mesh.mesh;
-        let file_vertex = |i: u32| first_vertex + i;
-        let position = |i: u32| {
-            let i = i as usize * 3;
-            frame.point(DVec3::new(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2]))
-        };
-        let material = material_of[&mesh.material_id];
-        // Faces as written (all triangles when tobj lists no arities).
-        let arities: Box<dyn Iterator<Item = u32>> = if mesh.face_arities.is_empty() {
-            Box::new(std::iter::repeat_n(3, mesh.indices.len() / 3))
-        } else {
-            Box::new(mesh.face_arities.iter().copied())
-        };
-        let mut start = 0;
-        for arity in arities {
-            let indices = &mesh.indices[start..start + arity as usize];
-            let face: Vec<Vec3> = indices.iter().map(|&i| position(i)).collect();
-            start += arity as usize;
-            let pieces = polygon::triangulate(&face);
-            degenerate += usize::from(pieces.is_empty());
-            for [a, b, c] in pieces {
-                let file_vertices = [a, b, c].map(|k| file_vertex(indices[k]));
-                let triangle = Triangle { vertices: [face[a], face[b], face[c]], material, file_vertices };
-                let mut corners = triangle.vertices.map(|v| v.to_array().map(f32::to_bits));
-                corners.sort_unstable();
+    let points: Vec<Vec3> = par_map(None, model.positions.len(), |k| frame.point(model.positions[k]));
+    // Faces triangulated side by side, in blocks; each block's triangles
+    // and degenerate faces in file order.
+    const BLOCK: usize = 4096;
+    let blocks = par_map(None, model.faces.len().div_ceil(BLOCK), |block| {
+        let mut face: Vec<Vec3> = Vec::new();
+        let (mut pieces, mut degenerate) = (Vec::new(), 0usize);
+        for obj_face in &model.faces[block * BLOCK..((block + 1) * BLOCK).min(model.faces.len())] {
+            let corners = &model.corners[obj_face.corners.start as usize..obj_face.corners.end as usize];
+            face.clear();
+            face.extend(corners.iter().map(|c| points[c.position as usize]));
+            let material = material_of[&obj_face.material];
+            let triangles = polygon::triangulate(&face);
+            degenerate += usize::from(triangles.is_empty());
+            for [a, b, c] in triangles {
+                let triangle =
+                    Triangle { vertices: [face[a], face[b], face[c]], material, file_vertices: [a, b, c].map(|k| corners[k].vertex) };
                 if is_degenerate(&triangle) {
                     degenerate += 1;
-                } else if !seen.insert((corners, material)) {
-                    duplicated += 1;
                 } else {
-                    triangles.push(triangle);
+                    pieces.push(triangle);
                 }
             }
         }
-        first_vertex += (mesh.positions.len() / 3) as u32;
+        (pieces, degenerate)
+    });
+    let degenerate: usize = blocks.iter().map(|(_, degenerate)| degenerate).sum();
+    let candidates: Vec<Triangle> = blocks.into_iter().flat_map(|(pieces, _)| pieces).collect();
+    // Faces written twice (same corners, same material) count once: copies
+    // would weigh on every ray and pass for nothing. Found by sorting the
+    // triangles by a hash of their corners, the first of each kept (a set
+    // of all the corners took 0.1 s of a large model's load).
+    let key = |t: &Triangle| {
+        let mut corners = t.vertices.map(|v| v.to_array().map(f32::to_bits));
+        corners.sort_unstable();
+        (corners, t.material)
+    };
+    let hash = |t: &Triangle| {
+        let mut hash = rustc_hash::FxHasher::default();
+        key(t).hash(&mut hash);
+        hash.finish()
+    };
+    let mut by_hash: Vec<(u64, u32)> = par_map(None, candidates.len(), |k| (hash(&candidates[k]), k as u32));
+    by_hash.sort_unstable();
+    let mut copy = vec![false; candidates.len()];
+    for same in by_hash.chunk_by(|a, b| a.0 == b.0).filter(|same| same.len() > 1) {
+        for (n, &(_, later)) in same.iter().enumerate().skip(1) {
+            let later_key = key(&candidates[later as usize]);
+            copy[later as usize] =
+                same[..n].iter().any(|&(_, earlier)| !copy[earlier as usize] && key(&candidates[earlier as usize]) == later_key);
+        }
     }
+    let duplicated = copy.iter().filter(|&&c| c).count();
+    let triangles: Vec<Triangle> = candidates.into_iter().zip(copy).filter(|(_, copy)| !copy).map(|(t, _)| t).collect();
     if duplicated > 0 {
         warnings.push(SceneWarning {
             location: Location::file(path),
@@ -259,14 +483,14 @@ pub fn triangles(
     Ok(triangles)
 }
 
-/// The centre of the model's bounds (model units, f64) when it lies farther
-/// than `beyond` from the origin; `None` for a model near its origin.
+/// The centre of the bounds of the vertices faces use (model units, f64)
+/// when it lies farther than `beyond` from the origin; `None` for a model
+/// near its origin.
 pub fn far_centre(model: &ObjModel, beyond: f64) -> Option<DVec3> {
     let (lo, hi) = model
-        .meshes
+        .corners
         .iter()
-        .flat_map(|m| m.mesh.positions.chunks_exact(3))
-        .map(|p| DVec3::new(p[0], p[1], p[2]))
+        .map(|c| model.positions[c.position as usize])
         .fold((DVec3::MAX, DVec3::MIN), |(lo, hi), p| (lo.min(p), hi.max(p)));
     let centre = (lo + hi) / 2.0;
     (lo.x <= hi.x && centre.abs().max_element() > beyond).then_some(centre)
@@ -279,4 +503,89 @@ fn is_degenerate(triangle: &Triangle) -> bool {
     let longest = (b - a).length_squared().max((c - b).length_squared()).max((a - c).length_squared());
     let doubled_area = triangle.cross().length();
     !(doubled_area > 1e-6 * longest && doubled_area > 2e-12)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PATH: &str = "model.obj";
+
+    fn read_text(text: &str, chunk_bytes: usize) -> Result<ObjModel, SceneError> {
+        read_in_chunks(Path::new(PATH), text, &scan(text), &[], chunk_bytes)
+    }
+
+    fn faces(model: &ObjModel) -> Vec<(Option<&str>, Vec<u32>, Vec<u32>)> {
+        model
+            .faces
+            .iter()
+            .map(|f| {
+                let corners = &model.corners[f.corners.start as usize..f.corners.end as usize];
+                (
+                    f.material.map(|m| model.materials[m].name.as_str()),
+                    corners.iter().map(|c| c.position).collect(),
+                    corners.iter().map(|c| c.vertex).collect(),
+                )
+            })
+            .collect()
+    }
+
+    /// Every way a corner may be written, indices back from the last
+    /// vertex read, runs of faces between `o`, `g` and `usemtl`, a
+    /// multi-byte name: read the same however the text is cut, down to a
+    /// line a chunk.
+    #[test]
+    fn a_file_reads_the_same_however_it_is_cut() {
+        let text = "# a test\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\nvn 0 0 -1\n\
+                    f 1 2 3\nusemtl béton\nf 1/1 2/2 3/3 4\nf -4//1 -3//1 -2//2\no next\nf 1/1/1 2/2/1 3/3/1\n\
+                    v 0 0 2\nf -1 -4 -3 # a comment\nusemtl béton\nf 1 2 5\ng last\nl 1 2\nf 1 2\nf 5 2 3 4\n";
+        let whole = read_text(text, 1 << 20).unwrap();
+        let faces_whole = faces(&whole);
+        let b = Some("béton");
+        let expected_positions =
+            [vec![0, 1, 2], vec![0, 1, 2, 3], vec![0, 1, 2], vec![0, 1, 2], vec![4, 1, 2], vec![0, 1, 4], vec![4, 1, 2, 3]];
+        let got: Vec<_> = faces_whole.iter().map(|(_, positions, _)| positions.clone()).collect();
+        assert_eq!(got, expected_positions, "points and lines are not faces");
+        let materials: Vec<_> = faces_whole.iter().map(|(m, _, _)| *m).collect();
+        assert_eq!(materials, [None, b, b, b, b, b, b]);
+        for bytes in [1, 7, 40, 100] {
+            let cut = read_text(text, bytes).unwrap();
+            assert_eq!(cut.positions, whole.positions, "in chunks of {bytes} bytes");
+            assert_eq!(faces(&cut), faces_whole, "in chunks of {bytes} bytes");
+        }
+    }
+
+    /// A file vertex is a position with its texture and normal within one
+    /// run of faces: shared by faces written with it, apart across runs or
+    /// with another normal.
+    #[test]
+    fn file_vertices_are_position_texture_and_normal_within_a_run() {
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 -1\n\
+                    f 1//1 2//1 3//1\nf 1//1 3//1 4//1\nf 1//2 3//2 4//2\nusemtl a\nf 1//1 2//1 3//1\n";
+        let model = read_text(text, 1 << 20).unwrap();
+        let vertices: Vec<Vec<u32>> = faces(&model).into_iter().map(|(_, _, v)| v).collect();
+        assert_eq!(vertices[0], [0, 1, 2]);
+        assert_eq!(vertices[1], [0, 2, 3], "the same vertices, shared");
+        assert_eq!(vertices[2], [4, 5, 6], "another normal: other vertices");
+        assert_eq!(vertices[3], [7, 8, 9], "another run: other vertices");
+    }
+
+    /// A corner that names no vertex is one error naming its line.
+    #[test]
+    fn bad_corners_name_their_line() {
+        for (face, message) in [
+            ("f 1 2 9", "face names vertex 9 but the file has 3 vertices"),
+            ("f 1 -7 3", "face goes back past the file's first vertex"),
+            ("f 1 x 3", "face corner 'x' names no vertex"),
+            ("f 1 0 3", "face corner '0' names no vertex"),
+            ("f 1 /2 3", "face corner '/2' names no vertex"),
+        ] {
+            let text = format!("v 0 0 0\nv 1 0 0\n\nv 1 1 0\n{face}\n");
+            for bytes in [1, 1 << 20] {
+                let error = read_text(&text, bytes).err().unwrap_or_else(|| panic!("{face} read"));
+                assert_eq!(error.location.line, Some(5), "{face}");
+                assert!(error.message.starts_with(message), "{face}: {}", error.message);
+            }
+        }
+    }
 }
