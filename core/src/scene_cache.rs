@@ -93,9 +93,14 @@ fn key(scene_path: &Path, scene_text: &str, obj_text: &str) -> u64 {
         env!("HELIODON_CORE_SOURCE_HASH").as_bytes(),
     ];
     // Lengths first, so no two different lists hash the same bytes.
-    for part in loader.into_iter().chain([scene_path.as_os_str().as_encoded_bytes(), scene_text.as_bytes(), obj_text.as_bytes()]) {
+    for part in loader.into_iter().chain([scene_path.as_os_str().as_encoded_bytes(), scene_text.as_bytes()]) {
         hash.u64(part.len() as u64).bytes(part);
     }
+    // The OBJ (tens of megabytes) a megabyte a block, side by side.
+    let megabytes: Vec<&[u8]> = obj_text.as_bytes().chunks(1 << 20).collect();
+    hash.blocks_of(&megabytes, 1, |h, block| {
+        h.bytes(block);
+    });
     hash.finish()
 }
 

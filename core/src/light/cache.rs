@@ -105,15 +105,55 @@ impl StableHash {
         self.u64(v.to_bits())
     }
 
+    /// `v`'s four bytes: two make a word without the byte-by-byte path.
+    pub fn u32(&mut self, v: u32) -> &mut Self {
+        match self.filled {
+            0 => {
+                self.pending[..4].copy_from_slice(&v.to_le_bytes());
+                (self.filled, self.len) = (4, self.len + 4);
+            }
+            4 => {
+                self.len += 4;
+                self.filled = 0;
+                let low = u64::from(u32::from_le_bytes(self.pending[..4].try_into().expect("four bytes")));
+                self.word(low | u64::from(v) << 32);
+            }
+            _ => {
+                self.bytes(&v.to_le_bytes());
+            }
+        }
+        self
+    }
+
     /// `values`, each by its bits.
     pub fn f32s(&mut self, values: &[f32]) -> &mut Self {
-        let pairs = values.chunks_exact(2);
-        let last = pairs.remainder().first().map(|v| v.to_bits());
-        for pair in pairs {
-            self.u64(u64::from(pair[0].to_bits()) | u64::from(pair[1].to_bits()) << 32);
+        for v in values {
+            self.u32(v.to_bits());
         }
-        if let Some(bits) = last {
-            self.bytes(&bits.to_le_bytes());
+        self
+    }
+
+    /// Points, each coordinate by its bits.
+    pub fn points(&mut self, points: &[glam::Vec3]) -> &mut Self {
+        for p in points {
+            self.f32s(&p.to_array());
+        }
+        self
+    }
+
+    /// `items` in blocks of `per_block` hashed side by side, each item
+    /// with `each`, then the count and the blocks' hashes in order: the
+    /// same on any number of threads (a large model's triangles were 45 ms
+    /// of every start in one stream).
+    pub fn blocks_of<T: Sync>(&mut self, items: &[T], per_block: usize, each: impl Fn(&mut Self, &T) + Sync) -> &mut Self {
+        let blocks = crate::parallel::par_map(None, items.len().div_ceil(per_block), |b| {
+            let mut block = Self::new();
+            items[b * per_block..((b + 1) * per_block).min(items.len())].iter().for_each(|item| each(&mut block, item));
+            block.finish()
+        });
+        self.u64(items.len() as u64);
+        for block in blocks {
+            self.u64(block);
         }
         self
     }
@@ -142,9 +182,9 @@ impl StableHash {
 pub fn key(scene: &Scene, settings: &LightSettings) -> u64 {
     let mut hash = StableHash::new();
     hash.bytes(MAGIC).u64(u64::from(FORMAT)).bytes(env!("CARGO_PKG_VERSION").as_bytes());
-    for triangle in &scene.patches.triangles {
-        hash.f32s(&triangle.map(|v| v.to_array()).concat());
-    }
+    hash.blocks_of(&scene.patches.triangles, 1 << 14, |h, triangle| {
+        h.points(triangle);
+    });
     // How many rays each patch traces follows the focus.
     hash.f32s(&scene.patch_sizing.as_floats());
     for sensor in &scene.sensors {
@@ -153,12 +193,12 @@ pub fn key(scene: &Scene, settings: &LightSettings) -> u64 {
     }
     // Which shells close (the sides dark inside solids) depends on the
     // model's triangles and on its file's vertices.
-    for triangle in &scene.triangles {
-        hash.f32s(&triangle.vertices.map(|v| v.to_array()).concat());
+    hash.blocks_of(&scene.triangles, 1 << 14, |h, triangle| {
+        h.points(&triangle.vertices);
         for vertex in triangle.file_vertices {
-            hash.u64(u64::from(vertex));
+            h.u64(u64::from(vertex));
         }
-    }
+    });
     for patch in &scene.patches.patches {
         hash.u64(u64::from(patch.triangles.end)).u64(u64::from(patch.surface)).u64(u64::from(patch.material));
     }
@@ -986,6 +1026,10 @@ mod tests {
         let bytes: Vec<u8> = floats.iter().flat_map(|v| v.to_bits().to_le_bytes()).collect();
         assert_eq!(StableHash::new().f32s(&floats).finish(), StableHash::new().bytes(&bytes).finish());
         assert_eq!(StableHash::new().u64(7).finish(), StableHash::new().bytes(&7u64.to_le_bytes()).finish());
+        // Four-byte values after an odd number of bytes, too.
+        let mixed = StableHash::new().bytes(&[1, 2, 3]).u32(9).f32s(&floats).u32(4).finish();
+        let as_bytes: Vec<u8> = [vec![1, 2, 3], 9u32.to_le_bytes().to_vec(), bytes.clone(), 4u32.to_le_bytes().to_vec()].concat();
+        assert_eq!(mixed, StableHash::new().bytes(&as_bytes).finish());
     }
 
     /// A sensor's landings read back as written, the points on a flat

@@ -6,17 +6,16 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::cli::CliError;
+use crate::cli::args::load_for_command;
 use crate::light::{LightModel, WindowGroups};
 use crate::panel::PanelCatalog;
-use crate::scene::{self, MaterialKind, Scene};
+use crate::scene::{MaterialKind, Scene};
 
-/// Prints the summary of the scene file at `path`.
+/// Prints the summary of the scene file at `path`, loaded through the
+/// scene cache as the other commands load it.
 pub fn run(path: &Path, panels: &PanelCatalog) -> Result<(), CliError> {
-    let loaded = scene::load_scene(path, panels).map_err(|e| CliError::failure(e.to_string()))?;
-    for warning in &loaded.warnings {
-        eprintln!("warning: {warning}");
-    }
-    print!("{}", info(&loaded.scene, &LightModel::unlit(Arc::new(loaded.scene.clone())).windows));
+    let scene = Arc::new(load_for_command(path, panels, false).map_err(CliError::failure)?);
+    print!("{}", info(&scene, &LightModel::unlit(scene.clone()).windows));
     Ok(())
 }
 
