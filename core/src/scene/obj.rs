@@ -33,21 +33,47 @@ pub struct ObjScan {
 }
 
 /// Scans OBJ text for references and faces (what reading the model needs
-/// first: its MTL libraries and the material names it uses).
+/// first: its MTL libraries and the material names it uses), in chunks
+/// side by side as [`read`] does.
 pub fn scan(text: &str) -> ObjScan {
-    let mut scan = ObjScan::default();
-    for (index, line) in text.lines().enumerate() {
-        let line = line.trim();
-        let (keyword, rest) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
-        let rest = rest.trim();
-        match keyword {
-            "f" => scan.face_count += 1,
-            "mtllib" if !rest.is_empty() => scan.material_libraries.push(Reference { line: index + 1, name: rest.to_string() }),
-            "usemtl" if !rest.is_empty() && !scan.used_materials.iter().any(|r| r.name == rest) => {
-                scan.used_materials.push(Reference { line: index + 1, name: rest.to_string() });
+    scan_in_chunks(text, CHUNK_BYTES)
+}
+
+/// [`scan`] in chunks of about `chunk_bytes`.
+fn scan_in_chunks(text: &str, chunk_bytes: usize) -> ObjScan {
+    let pieces = chunks(text, chunk_bytes);
+    let scanned = par_map(None, pieces.len(), |k| {
+        let (mut piece, mut lines) = (ObjScan::default(), 0);
+        let mut used = std::collections::HashSet::new();
+        for (index, line) in pieces[k].lines().enumerate() {
+            lines += 1;
+            let line = line.trim();
+            let (keyword, rest) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
+            let rest = rest.trim();
+            match keyword {
+                "f" => piece.face_count += 1,
+                "mtllib" if !rest.is_empty() => piece.material_libraries.push(Reference { line: index, name: rest.to_string() }),
+                "usemtl" if !rest.is_empty() && used.insert(rest) => {
+                    piece.used_materials.push(Reference { line: index, name: rest.to_string() })
+                }
+                _ => {}
             }
-            _ => {}
         }
+        (piece, lines)
+    });
+    // Lines numbered from the file's start, each name used once: at its first line.
+    let mut scan = ObjScan::default();
+    let (mut first_line, mut used) = (0, std::collections::HashSet::new());
+    for (piece, lines) in scanned {
+        let numbered = |r: Reference| Reference { line: first_line + r.line + 1, ..r };
+        scan.material_libraries.extend(piece.material_libraries.into_iter().map(numbered));
+        for reference in piece.used_materials {
+            if used.insert(reference.name.clone()) {
+                scan.used_materials.push(numbered(reference));
+            }
+        }
+        scan.face_count += piece.face_count;
+        first_line += lines;
     }
     scan
 }
@@ -548,7 +574,13 @@ mod tests {
         assert_eq!(got, expected_positions, "points and lines are not faces");
         let materials: Vec<_> = faces_whole.iter().map(|(m, _, _)| *m).collect();
         assert_eq!(materials, [None, b, b, b, b, b, b]);
+        let scanned = |bytes| {
+            let scan = scan_in_chunks(text, bytes);
+            (scan.face_count, scan.used_materials.iter().map(|r| (r.name.clone(), r.line)).collect::<Vec<_>>())
+        };
+        assert_eq!(scanned(1 << 20), (8, vec![("béton".to_string(), 12)]));
         for bytes in [1, 7, 40, 100] {
+            assert_eq!(scanned(bytes), scanned(1 << 20), "scanned in chunks of {bytes} bytes");
             let cut = read_text(text, bytes).unwrap();
             assert_eq!(cut.positions, whole.positions, "in chunks of {bytes} bytes");
             assert_eq!(faces(&cut), faces_whole, "in chunks of {bytes} bytes");
