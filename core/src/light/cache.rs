@@ -146,10 +146,10 @@ impl StableHash {
     /// same on any number of threads (a large model's triangles were 45 ms
     /// of every start in one stream).
     pub fn blocks_of<T: Sync>(&mut self, items: &[T], per_block: usize, each: impl Fn(&mut Self, &T) + Sync) -> &mut Self {
-        let blocks = crate::parallel::par_map(None, items.len().div_ceil(per_block), |b| {
-            let mut block = Self::new();
-            items[b * per_block..((b + 1) * per_block).min(items.len())].iter().for_each(|item| each(&mut block, item));
-            block.finish()
+        let blocks = crate::parallel::par_chunks(None, items, per_block, |block| {
+            let mut hash = Self::new();
+            block.iter().for_each(|item| each(&mut hash, item));
+            hash.finish()
         });
         self.u64(items.len() as u64);
         for block in blocks {

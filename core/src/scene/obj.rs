@@ -14,7 +14,7 @@ use glam::{DVec3, Vec3};
 use super::error::{Location, SceneError, SceneWarning};
 use super::frame::ModelFrame;
 use super::{MAX_COORDINATE, Triangle, polygon};
-use crate::parallel::par_map;
+use crate::parallel::{par_chunks, par_map};
 
 /// A `mtllib` or `usemtl` reference and the line it stands on.
 #[derive(Debug, Clone)]
@@ -39,6 +39,13 @@ pub fn scan(text: &str) -> ObjScan {
     scan_in_chunks(text, CHUNK_BYTES)
 }
 
+/// An OBJ line's keyword and the rest of it, trimmed.
+fn statement(line: &str) -> (&str, &str) {
+    let line = line.trim();
+    let (keyword, rest) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
+    (keyword, rest.trim())
+}
+
 /// [`scan`] in chunks of about `chunk_bytes`.
 fn scan_in_chunks(text: &str, chunk_bytes: usize) -> ObjScan {
     let pieces = chunks(text, chunk_bytes);
@@ -47,9 +54,7 @@ fn scan_in_chunks(text: &str, chunk_bytes: usize) -> ObjScan {
         let mut used = std::collections::HashSet::new();
         for (index, line) in pieces[k].lines().enumerate() {
             lines += 1;
-            let line = line.trim();
-            let (keyword, rest) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
-            let rest = rest.trim();
+            let (keyword, rest) = statement(line);
             match keyword {
                 "f" => piece.face_count += 1,
                 "mtllib" if !rest.is_empty() => piece.material_libraries.push(Reference { line: index, name: rest.to_string() }),
@@ -306,8 +311,7 @@ fn read_chunk(text: &str, materials: &HashMap<&str, usize>) -> Chunk {
         if chunk.error.is_some() {
             continue;
         }
-        let line = line.trim();
-        let (keyword, rest) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
+        let (keyword, rest) = statement(line);
         let fail = |chunk: &mut Chunk, message: String| chunk.error = Some((line_index, message));
         match keyword {
             "v" => match vertex(rest) {
@@ -341,9 +345,9 @@ fn read_chunk(text: &str, materials: &HashMap<&str, usize>) -> Chunk {
                 }
             }
             "o" | "g" => chunk.runs += 1,
-            "usemtl" if !rest.trim().is_empty() => {
+            "usemtl" if !rest.is_empty() => {
                 chunk.runs += 1;
-                chunk.last_material = Some(materials.get(rest.trim()).copied());
+                chunk.last_material = Some(materials.get(rest).copied());
             }
             _ => {}
         }
@@ -408,8 +412,9 @@ fn join(path: &Path, chunks: Vec<Chunk>, materials: Vec<MtlMaterial>) -> Result<
                     // A large run's table is not cleared bucket by bucket at every small one after it.
                     if numbers.capacity() > 1024 {
                         numbers = rustc_hash::FxHashMap::default();
+                    } else {
+                        numbers.clear();
                     }
-                    numbers.clear();
                 }
                 let next = numbered + numbers.len() as u32;
                 let vertex = *numbers.entry((position, vt, vn)).or_insert(next);
@@ -440,11 +445,10 @@ pub fn triangles(
     let points: Vec<Vec3> = par_map(None, model.positions.len(), |k| frame.point(model.positions[k]));
     // Faces triangulated side by side, in blocks; each block's triangles
     // and degenerate faces in file order.
-    const BLOCK: usize = 4096;
-    let blocks = par_map(None, model.faces.len().div_ceil(BLOCK), |block| {
+    let blocks = par_chunks(None, &model.faces, 4096, |block| {
         let mut face: Vec<Vec3> = Vec::new();
         let (mut pieces, mut degenerate) = (Vec::new(), 0usize);
-        for obj_face in &model.faces[block * BLOCK..((block + 1) * BLOCK).min(model.faces.len())] {
+        for obj_face in block {
             let corners = &model.corners[obj_face.corners.start as usize..obj_face.corners.end as usize];
             face.clear();
             face.extend(corners.iter().map(|c| points[c.position as usize]));

@@ -1,10 +1,7 @@
 //! Surfaces: the model's triangles grouped into connected planar pieces of one
 //! material (a wall, a desk top, a window pane), and the windows among them.
 
-use std::hash::{Hash, Hasher};
-
 use glam::Vec3;
-use rustc_hash::FxHashMap;
 
 use super::material::Material;
 use super::{Surface, Triangle, Window};
@@ -25,33 +22,10 @@ pub fn group(triangles: Vec<Triangle>) -> (Vec<Triangle>, Vec<Surface>) {
     // The welded corners numbered, each edge the pair of its corners'
     // numbers beside its triangle, sorted: the triangles on one edge lie
     // together, in their order.
-    // Two threads number the corners, each those whose key falls in its
-    // half, in a map of its own: half the size of one for all of them.
-    let half = |which: u32| {
-        let mut numbers: FxHashMap<[i64; 3], u32> = FxHashMap::default();
-        let mine = |key: &[i64; 3]| {
-            let mut hash = rustc_hash::FxHasher::default();
-            key.hash(&mut hash);
-            hash.finish() as u32 & 1 == which
-        };
-        let corners: Vec<u32> = triangles
-            .iter()
-            .flat_map(|t| t.vertices)
-            .map(|v| {
-                let key = weld_key(v);
-                if !mine(&key) {
-                    return u32::MAX;
-                }
-                let next = 2 * numbers.len() as u32 + which;
-                *numbers.entry(key).or_insert(next)
-            })
-            .collect();
-        corners
-    };
-    let (evens, odds) = crate::parallel::par_join(None, || half(0), || half(1));
+    let numbers = crate::parallel::number_alike(triangles.len() * 3, |corner| weld_key(triangles[corner / 3].vertices[corner % 3]));
     let mut edges: Vec<(u64, u32)> = Vec::with_capacity(triangles.len() * 3);
     for t in 0..triangles.len() {
-        let corners: [u32; 3] = std::array::from_fn(|k| evens[3 * t + k].min(odds[3 * t + k]));
+        let corners: [u32; 3] = std::array::from_fn(|k| numbers[3 * t + k]);
         for (a, b) in [(corners[0], corners[1]), (corners[1], corners[2]), (corners[2], corners[0])] {
             edges.push(((u64::from(a.min(b)) << 32) | u64::from(a.max(b)), t as u32));
         }
