@@ -71,6 +71,7 @@ fn main() {
             render(OffscreenRequest {
                 scene: path.clone(),
                 view: Some(view.clone()),
+                fov: None,
                 width,
                 height,
                 when: Some(LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(14.0).unwrap() }),

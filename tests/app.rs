@@ -121,6 +121,7 @@ fn a_render_that_fails_says_why() {
     let error = offscreen::render(OffscreenRequest {
         scene: PathBuf::from("no/such/scene.toml"),
         view: None,
+        fov: None,
         width: 16,
         height: 16,
         when: None,
@@ -138,6 +139,7 @@ fn render_smoke_test_draws_the_model() {
     let request = OffscreenRequest {
         scene: heliodon::bundled_scene("test_room"),
         view: None,
+        fov: None,
         width: 320,
         height: 240,
         when: None,
@@ -170,6 +172,51 @@ fn render_smoke_test_draws_the_model() {
     assert!(levels.len() >= 4, "shades {levels:?}");
 }
 
+/// A field of view given without a view narrows the initial view (here the
+/// scene's first camera, 70°): the picture is the middle of the wide one,
+/// enlarged. Half the tangent of the half-angle shows the middle half each way.
+#[test]
+fn a_field_of_view_alone_narrows_the_initial_view() {
+    let request = |fov: Option<f32>| OffscreenRequest {
+        scene: heliodon::bundled_scene("test_room"),
+        view: None,
+        fov,
+        width: 160,
+        height: 120,
+        when: None,
+        sky: None,
+        settings: RenderSettings { exposure: Some(10.0), ..Default::default() },
+        light: Default::default(),
+        panels: Default::default(),
+    };
+    let half_tangent = (35.0f32.to_radians().tan() / 2.0).atan().to_degrees() * 2.0;
+    let (wide, narrow) = (offscreen::render(request(None)).unwrap(), offscreen::render(request(Some(half_tangent))).unwrap());
+    let luminance = |image: &offscreen::RenderedImage, x: std::ops::Range<u32>, y: std::ops::Range<u32>| {
+        let (mut sum, mut n) = (0.0, 0.0);
+        for row in y {
+            for column in x.clone() {
+                let p = &image.rgba[4 * (row * image.width + column) as usize..][..3];
+                sum += 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]);
+                n += 1.0;
+            }
+        }
+        sum / n
+    };
+    let (whole, middle, zoomed) = (luminance(&wide, 0..160, 0..120), luminance(&wide, 40..120, 30..90), luminance(&narrow, 0..160, 0..120));
+    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    wide.save_png(&out.join("fov_wide.png")).unwrap();
+    narrow.save_png(&out.join("fov_narrow.png")).unwrap();
+    println!("mean luminance: wide {whole:.1}, its middle {middle:.1}, the narrow view {zoomed:.1}");
+    assert!(
+        (zoomed - middle).abs() < 0.05 * middle,
+        "the narrow view {zoomed:.1} against the wide one's middle {middle:.1} (whole {whole:.1})"
+    );
+    assert!(
+        (zoomed - whole).abs() > 2.0 * (zoomed - middle).abs(),
+        "the narrow view {zoomed:.1} is not the middle {middle:.1} of the whole {whole:.1}"
+    );
+}
+
 /// The offscreen job switches on, once its light has arrived, only the
 /// cameras waiting for it (`AwaitsLight`): one taken out of them keeps the
 /// state it is given. The render bench draws the viewer's one view so; when
@@ -179,6 +226,7 @@ fn the_offscreen_job_switches_only_its_waiting_cameras() {
     let request = OffscreenRequest {
         scene: heliodon::bundled_scene("test_room"),
         view: None,
+        fov: None,
         width: 32,
         height: 24,
         when: None,
@@ -224,6 +272,7 @@ fn edges_are_smoothed_toward_a_supersampled_picture() {
     let request = |width: u32, height: u32| OffscreenRequest {
         scene: heliodon::bundled_scene("office"),
         view: None,
+        fov: None,
         width,
         height,
         when: Some(LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(14.0).unwrap() }),
@@ -288,6 +337,7 @@ fn the_sky_drawn_around_the_model_is_the_sky_model() {
     let request = OffscreenRequest {
         scene: scene_path,
         view: Some(view.clone()),
+        fov: None,
         width: width as u32,
         height: height as u32,
         when: Some(when),
@@ -324,6 +374,7 @@ fn office_picture(view: &Viewpoint, (year, month, day, hour): (i32, u32, u32, f6
     let request = OffscreenRequest {
         scene: heliodon::bundled_scene("office"),
         view: Some(view.clone()),
+        fov: None,
         width: 120,
         height: 120,
         when: Some(LocalDateTime { date: Date::new(year, month, day).unwrap(), time: TimeOfDay::from_hours(hour).unwrap() }),
@@ -597,6 +648,7 @@ fn compare_direct_sun(path: &std::path::Path, view: &Viewpoint, date: &str, time
     let request = OffscreenRequest {
         scene: path.to_path_buf(),
         view: Some(view.clone()),
+        fov: None,
         width: 320,
         height: 200,
         when: Some(LocalDateTime { date: Date::parse(date).unwrap(), time: TimeOfDay::parse(time).unwrap() }),

@@ -124,6 +124,7 @@ fn ready_app(scene: PathBuf, mode: RenderMode) -> (App, String) {
     let request = OffscreenRequest {
         scene,
         view: None,
+        fov: None,
         width,
         height,
         when: Some(LocalDateTime { date: Date::new(2026, 3, 21).unwrap(), time: TimeOfDay::from_hours(10.0).unwrap() }),

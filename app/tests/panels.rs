@@ -408,6 +408,7 @@ fn panel_lobes_are_drawn_where_the_engine_puts_them() {
         let request = OffscreenRequest {
             scene: path.clone(),
             view: Some(scene.viewpoints[0].clone()),
+            fov: None,
             width: 320,
             height: 200,
             when: Some(LocalDateTime { date: Date::new(date.0, date.1, date.2).unwrap(), time: TimeOfDay::from_hours(hours).unwrap() }),
@@ -454,6 +455,7 @@ fn a_panel_shows_its_lobes_to_an_eye_inside_their_cones() {
         let image = render(OffscreenRequest {
             scene: path.clone(),
             view: Some(view),
+            fov: None,
             width: 33,
             height: 33,
             when: Some(LocalDateTime { date: Date::new(2026, 12, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() }),
@@ -504,6 +506,7 @@ fn an_overhang_shades_the_lobes_of_a_panel() {
     let request = OffscreenRequest {
         scene: path.clone(),
         view: Some(view),
+        fov: None,
         width: 320,
         height: 200,
         when: Some(LocalDateTime { date: Date::new(2026, 12, 21).unwrap(), time: TimeOfDay::from_hours(12.0).unwrap() }),

@@ -39,6 +39,10 @@ pub struct OffscreenRequest {
     pub scene: PathBuf,
     /// `None`: the scene's initial view ([`initial_view`]).
     pub view: Option<Viewpoint>,
+    /// The vertical field of view (degrees) in place of the view's own,
+    /// the initial view's too: it is found as the scene spawns, from the
+    /// light model the picture is drawn with.
+    pub fov: Option<f32>,
     pub width: u32,
     pub height: u32,
     /// Local time at the site; `None`: the app's default.
@@ -237,7 +241,8 @@ fn spawn_cameras(
     }
     let Some(scene) = &active.scene else { return };
     let model = ray_model.as_ref().and_then(|m| m.of(scene));
-    let view = job.request.view.clone().unwrap_or_else(|| initial_view(scene, model.map(|m| m.as_ref())));
+    let mut view = job.request.view.clone().unwrap_or_else(|| initial_view(scene, model.map(|m| m.as_ref())));
+    view.fov = job.request.fov.unwrap_or(view.fov);
     let (width, height) = (job.request.width, job.request.height);
     let picture = images.add(Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None));
     let physical = images.add(Image::new_target_texture(width, height, TextureFormat::Rgba32Float, None));

@@ -66,7 +66,7 @@ fn parse_mode(text: &str) -> Result<RenderMode, String> {
 pub fn run(args: &RenderArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     let (case, sky) = (&args.case, args.case.sky.spec()?);
     let scene = load_for_command(&case.scene, panels, false)?;
-    let mut view = match &args.camera {
+    let view = match &args.camera {
         Some(name) => Some(scene.viewpoints.iter().find(|v| &v.name == name).cloned().ok_or_else(|| {
             let known: Vec<&str> = scene.viewpoints.iter().map(|v| v.name.as_str()).collect();
             format!(
@@ -80,15 +80,10 @@ pub fn run(args: &RenderArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     if view.as_ref().is_some_and(|v| (v.eye - v.target).length() < 1e-6) {
         return Err(CliError::failure("--eye and --target are the same point"));
     }
-    if let Some(fov) = args.fov {
-        let base = view.unwrap_or_else(|| {
-            crate::render::initial_view(&scene, Some(&crate::light::LightModel::unlit(std::sync::Arc::new(scene.clone()))))
-        });
-        view = Some(Viewpoint { fov: fov as f32, ..base });
-    }
     let image = crate::render::offscreen::render(OffscreenRequest {
         scene: case.scene.clone(),
         view,
+        fov: args.fov.map(|fov| fov as f32),
         width: args.width,
         height: args.height,
         when: Some(case.when()),
