@@ -54,6 +54,43 @@ const SENSOR_LIFT: f64 = 0.01;
 /// ([`LightModel::seen_by_sensors`]).
 const SEEN_PROBE_RAYS: usize = 256;
 
+/// How directly a patch side's light reaches the sensors, which sets the
+/// share of its rays it traces.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Sight {
+    /// A sensor sees it ([`LightModel::seen_by_sensors`]).
+    Seen,
+    /// A side a sensor sees gathers from it.
+    SeenBySeen,
+    /// Its light is at least two bounces from every sensor.
+    Farther,
+}
+
+impl Sight {
+    /// Per patch side: [`Sight::Seen`] where `seen`, [`Sight::SeenBySeen`]
+    /// where one of the `seen_gathers` (of the seen sides) gathers from it.
+    fn of_sides<'a>(seen: &[bool], seen_gathers: impl Iterator<Item = &'a Gather>) -> Vec<Sight> {
+        let mut sight: Vec<Sight> = seen.iter().map(|&seen| if seen { Sight::Seen } else { Sight::Farther }).collect();
+        for &(side, _) in seen_gathers.flat_map(|gather| &gather.form_factors) {
+            if sight[side as usize] == Sight::Farther {
+                sight[side as usize] = Sight::SeenBySeen;
+            }
+        }
+        sight
+    }
+
+    /// The share of its rays a side traces: all when seen; else the
+    /// `unseen` share once per bounce farther from the sensors, and no more
+    /// than the share `where_it_lies` ([`crate::scene::PatchSizing::ray_share`]).
+    fn ray_share(self, where_it_lies: f64, unseen: f64) -> f64 {
+        match self {
+            Sight::Seen => 1.0,
+            Sight::SeenBySeen => where_it_lies.min(unseen),
+            Sight::Farther => where_it_lies.min(unseen * unseen),
+        }
+    }
+}
+
 /// Where a receiver's hemisphere light comes from: the **daylight
 /// coefficients** (bins of the sky sphere, each through the window it was
 /// seen through, see [`SkyKey`]) and the **form factors** (patch sides),
@@ -320,17 +357,20 @@ impl LightModel {
                 && b.side_gathers.len() == patches.len() * 2
                 && LightSettings { unseen_ray_share: model.settings.unseen_ray_share, ..b.settings } == model.settings
         });
-        // What a sensor sees straight gets all its rays: its noise would show.
+        // What a sensor sees straight gets all its rays: its noise would
+        // show. The sides those see are found by their own gathers, traced
+        // first; each step farther from the sensors takes the unseen share
+        // of the rays again.
         let seen = model.seen_by_sensors();
-        let share = |settings: &LightSettings, side: usize| {
+        let share = |settings: &LightSettings, side: usize, sight: &[Sight]| {
             let unseen_share = if model.scene.sensors.is_empty() { 1.0 } else { settings.unseen_ray_share };
-            (!dark[side]).then(|| if seen[side] { 1.0 } else { model.ray_shares[side / 2].min(unseen_share) })
+            (!dark[side]).then(|| sight[side].ray_share(model.ray_shares[side / 2], unseen_share))
         };
         let nothing = Arc::new(Gather::default());
-        let gathers = par_map(model.settings.threads, patches.len() * 2, |side| {
-            let own = share(&model.settings, side);
+        let gather_side = |side: usize, sight: &[Sight]| {
+            let own = share(&model.settings, side, sight);
             let gather = match (own, beside) {
-                (_, Some(b)) if share(&b.settings, side) == own => (b.side_gathers[side].clone(), false),
+                (_, Some(b)) if share(&b.settings, side, sight) == own => (b.side_gathers[side].clone(), false),
                 (None, _) => (nothing.clone(), false),
                 (Some(own), beside) => {
                     let traced = model.gather_patch_side(side, &targets, own);
@@ -343,7 +383,16 @@ impl LightModel {
             };
             tick();
             gather
-        });
+        };
+        let (first, then): (Vec<usize>, Vec<usize>) = (0..patches.len() * 2).partition(|&side| seen[side]);
+        let sight = Sight::of_sides(&seen, std::iter::empty());
+        let seen_gathers = par_map(model.settings.threads, first.len(), |k| gather_side(first[k], &sight));
+        let sight = Sight::of_sides(&seen, seen_gathers.iter().map(|(gather, _)| &**gather));
+        let other_gathers = par_map(model.settings.threads, then.len(), |k| gather_side(then[k], &sight));
+        let mut gathers = vec![(nothing.clone(), false); patches.len() * 2];
+        for (side, gather) in first.into_iter().zip(seen_gathers).chain(then.into_iter().zip(other_gathers)) {
+            gathers[side] = gather;
+        }
         let traced: Vec<bool>;
         (model.side_gathers, traced) = gathers.into_iter().unzip();
         let same_sunlit_sides = |b: &LightModel| {
@@ -684,4 +733,75 @@ fn place_sensor(tracer: &Tracer, sensor: &Sensor, n: usize) -> Vec<DVec3> {
 pub fn sensor_points(scene: &Scene) -> Vec<Vec<DVec3>> {
     let tracer = Tracer::new(&scene.patches);
     scene.sensors.iter().map(|s| place_sensor(&tracer, s, 4)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use std::fmt::Write as _;
+
+    use super::*;
+    use crate::panel::PanelCatalog;
+    use crate::scene::load_scene;
+
+    /// A 4 × 4 × 3 m room from `x0`, its faces wound inward, its south wall
+    /// glazed from 1 to 3 m across and 1 to 2 m up: OBJ quads.
+    fn room(obj: &mut String, x0: f64) {
+        let mut quad = |material: &str, corners: [[f64; 3]; 4]| {
+            let _ = writeln!(obj, "usemtl {material}");
+            for [x, y, z] in corners {
+                let _ = writeln!(obj, "v {} {y} {z}", x0 + x);
+            }
+            let _ = writeln!(obj, "f -4 -3 -2 -1");
+        };
+        quad("wall", [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 4.0, 0.0], [0.0, 4.0, 0.0]]);
+        quad("wall", [[0.0, 0.0, 3.0], [0.0, 4.0, 3.0], [4.0, 4.0, 3.0], [4.0, 0.0, 3.0]]);
+        quad("wall", [[0.0, 4.0, 0.0], [4.0, 4.0, 0.0], [4.0, 4.0, 3.0], [0.0, 4.0, 3.0]]);
+        quad("wall", [[0.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 4.0, 3.0], [0.0, 0.0, 3.0]]);
+        quad("wall", [[4.0, 0.0, 0.0], [4.0, 0.0, 3.0], [4.0, 4.0, 3.0], [4.0, 4.0, 0.0]]);
+        for (xa, xb, za, zb) in [(0.0, 4.0, 0.0, 1.0), (0.0, 4.0, 2.0, 3.0), (0.0, 1.0, 1.0, 2.0), (3.0, 4.0, 1.0, 2.0)] {
+            quad("wall", [[xa, 0.0, za], [xa, 0.0, zb], [xb, 0.0, zb], [xb, 0.0, za]]);
+        }
+        quad("glass", [[1.0, 0.0, 1.0], [1.0, 0.0, 2.0], [3.0, 0.0, 2.0], [3.0, 0.0, 1.0]]);
+    }
+
+    /// Two rooms side by side, each with its window, the sensor in the
+    /// first: a sensor facing up sees the ceiling, not the floor, which the
+    /// ceiling sees; the second room is lit only through its own window,
+    /// so its light is farther. The shares of rays follow.
+    #[test]
+    fn sides_trace_fewer_rays_the_farther_their_light_is_from_the_sensors() {
+        let dir = std::env::temp_dir().join(format!("heliodon-sight-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut obj = String::from("mtllib m.mtl\n");
+        room(&mut obj, 0.0);
+        room(&mut obj, 5.0);
+        std::fs::write(dir.join("m.obj"), obj).unwrap();
+        std::fs::write(dir.join("m.mtl"), "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.8\n").unwrap();
+        let scene = "[site]\nlatitude = 45.0\nlongitude = 0.0\ntimezone = 0.0\n[model]\nobj = \"m.obj\"\n\
+                     [[sensors]]\nname = \"desk\"\nposition = [2.0, 2.0, 0.8]\nnormal = [0.0, 0.0, 1.0]\n";
+        std::fs::write(dir.join("scene.toml"), scene).unwrap();
+        let scene = Arc::new(load_scene(&dir.join("scene.toml"), &PanelCatalog::new()).unwrap().scene);
+        std::fs::remove_dir_all(&dir).ok();
+        let settings = LightSettings { rays_per_patch: 64, window_rays_per_patch: 16, ..LightSettings::default() };
+        let model = LightModel::precompute(scene.clone(), settings).unwrap();
+        let seen = model.seen_by_sensors();
+        let seen_gathers = (0..seen.len()).filter(|&side| seen[side]).map(|side| model.side_gather(side));
+        let sight = Sight::of_sides(&seen, seen_gathers);
+        // Each inward side of the faces with its middle in `place`, facing `up`.
+        let sides = |place: &dyn Fn(glam::Vec3) -> bool, up: f32| {
+            let patches = scene.patches.patches.iter().enumerate().filter(|(_, p)| place(p.centroid) && p.normal.z * up > 0.5);
+            patches.map(|(p, patch)| sight[side_of(p as u32, patch.normal.z * up < 0.0) as usize]).collect::<Vec<_>>()
+        };
+        // The probes from the sensor may miss a corner patch of the ceiling;
+        // the ceiling's middle, over the sensor, is seen.
+        let ceiling = sides(&|c| (c.x - 2.0).abs() < 1.0 && (c.y - 2.0).abs() < 1.0 && c.z > 2.9, -1.0);
+        let floor = sides(&|c| c.x < 4.0 && c.z < 0.1, 1.0);
+        let other_floor = sides(&|c| c.x > 5.0 && c.z < 0.1, 1.0);
+        assert!(!ceiling.is_empty() && ceiling.iter().all(|&s| s == Sight::Seen), "{ceiling:?}");
+        assert!(!floor.is_empty() && floor.iter().all(|&s| s == Sight::SeenBySeen), "{floor:?}");
+        assert!(!other_floor.is_empty() && other_floor.iter().all(|&s| s == Sight::Farther), "{other_floor:?}");
+        assert_eq!(Sight::Seen.ray_share(0.5, 0.25), 1.0, "a seen side keeps its rays wherever it lies");
+        assert_eq!((Sight::SeenBySeen.ray_share(1.0, 0.25), Sight::Farther.ray_share(1.0, 0.25)), (0.25, 0.0625));
+        assert_eq!(Sight::Farther.ray_share(1.0, 1.0), 1.0, "a picture keeps every side's rays");
+    }
 }
