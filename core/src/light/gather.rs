@@ -54,39 +54,25 @@ const SENSOR_LIFT: f64 = 0.01;
 /// ([`LightModel::seen_by_sensors`]).
 const SEEN_PROBE_RAYS: usize = 256;
 
-/// How directly a patch side's light reaches the sensors, which sets the
-/// share of its rays it traces.
+/// How many bounces a patch side's light is from the sensors, which sets
+/// the share of its rays it traces: 0 for a side a sensor sees
+/// ([`LightModel::seen_by_sensors`]), k for one that a side k − 1 bounces
+/// away gathers from, [`Sight::FARTHER`] for the rest.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Sight {
-    /// A sensor sees it ([`LightModel::seen_by_sensors`]).
-    Seen,
-    /// A side a sensor sees gathers from it.
-    SeenBySeen,
-    /// Its light is at least two bounces from every sensor.
-    Farther,
-}
+struct Sight(u8);
 
 impl Sight {
-    /// Per patch side: [`Sight::Seen`] where `seen`, [`Sight::SeenBySeen`]
-    /// where one of the `seen_gathers` (of the seen sides) gathers from it.
-    fn of_sides<'a>(seen: &[bool], seen_gathers: impl Iterator<Item = &'a Gather>) -> Vec<Sight> {
-        let mut sight: Vec<Sight> = seen.iter().map(|&seen| if seen { Sight::Seen } else { Sight::Farther }).collect();
-        for &(side, _) in seen_gathers.flat_map(|gather| &gather.form_factors) {
-            if sight[side as usize] == Sight::Farther {
-                sight[side as usize] = Sight::SeenBySeen;
-            }
-        }
-        sight
-    }
+    const SEEN: Sight = Sight(0);
+    /// Beyond this many steps the share stops falling.
+    const FARTHER: Sight = Sight(3);
 
     /// The share of its rays a side traces: all when seen; else the
     /// `unseen` share once per bounce farther from the sensors, and no more
     /// than the share `where_it_lies` ([`crate::scene::PatchSizing::ray_share`]).
     fn ray_share(self, where_it_lies: f64, unseen: f64) -> f64 {
         match self {
-            Sight::Seen => 1.0,
-            Sight::SeenBySeen => where_it_lies.min(unseen),
-            Sight::Farther => where_it_lies.min(unseen * unseen),
+            Sight::SEEN => 1.0,
+            Sight(steps) => where_it_lies.min(unseen.powi(i32::from(steps))),
         }
     }
 }
@@ -384,14 +370,20 @@ impl LightModel {
             tick();
             gather
         };
-        let (first, then): (Vec<usize>, Vec<usize>) = (0..patches.len() * 2).partition(|&side| seen[side]);
-        let sight = Sight::of_sides(&seen, std::iter::empty());
-        let seen_gathers = par_map(model.settings.threads, first.len(), |k| gather_side(first[k], &sight));
-        let sight = Sight::of_sides(&seen, seen_gathers.iter().map(|(gather, _)| &**gather));
-        let other_gathers = par_map(model.settings.threads, then.len(), |k| gather_side(then[k], &sight));
+        // Step by step: the sides a step away, gathered, name those one more.
+        let mut sight: Vec<Sight> = seen.iter().map(|&seen| if seen { Sight::SEEN } else { Sight::FARTHER }).collect();
         let mut gathers = vec![(nothing.clone(), false); patches.len() * 2];
-        for (side, gather) in first.into_iter().zip(seen_gathers).chain(then.into_iter().zip(other_gathers)) {
-            gathers[side] = gather;
+        for step in 0..=Sight::FARTHER.0 {
+            let these: Vec<usize> = (0..sight.len()).filter(|&side| sight[side] == Sight(step)).collect();
+            let traced = par_map(model.settings.threads, these.len(), |k| gather_side(these[k], &sight));
+            for (side, gather) in these.into_iter().zip(traced) {
+                for &(next, _) in &gather.0.form_factors {
+                    if sight[next as usize] == Sight::FARTHER {
+                        sight[next as usize] = Sight(step + 1);
+                    }
+                }
+                gathers[side] = gather;
+            }
         }
         let traced: Vec<bool>;
         (model.side_gathers, traced) = gathers.into_iter().unzip();
@@ -767,7 +759,8 @@ mod tests {
     /// Two rooms side by side, each with its window, the sensor in the
     /// first: a sensor facing up sees the ceiling, not the floor, which the
     /// ceiling sees; the second room is lit only through its own window,
-    /// so its light is farther. The shares of rays follow.
+    /// so its light is farther. The rays each traces follow: a gather names
+    /// no more sides than it traced rays.
     #[test]
     fn sides_trace_fewer_rays_the_farther_their_light_is_from_the_sensors() {
         let dir = std::env::temp_dir().join(format!("heliodon-sight-{}", std::process::id()));
@@ -784,24 +777,38 @@ mod tests {
         std::fs::remove_dir_all(&dir).ok();
         let settings = LightSettings { rays_per_patch: 64, window_rays_per_patch: 16, ..LightSettings::default() };
         let model = LightModel::precompute(scene.clone(), settings).unwrap();
+        // Each side's steps from the sensors, as the gathers found them.
         let seen = model.seen_by_sensors();
-        let seen_gathers = (0..seen.len()).filter(|&side| seen[side]).map(|side| model.side_gather(side));
-        let sight = Sight::of_sides(&seen, seen_gathers);
-        // Each inward side of the faces with its middle in `place`, facing `up`.
+        let mut sight: Vec<Sight> = seen.iter().map(|&seen| if seen { Sight::SEEN } else { Sight::FARTHER }).collect();
+        for step in 0..Sight::FARTHER.0 {
+            let these: Vec<usize> = (0..sight.len()).filter(|&side| sight[side] == Sight(step)).collect();
+            for side in these {
+                for &(next, _) in &model.side_gather(side).form_factors {
+                    if sight[next as usize] == Sight::FARTHER {
+                        sight[next as usize] = Sight(step + 1);
+                    }
+                }
+            }
+        }
+        // The inward sides of the faces with their middles in `place`,
+        // facing `up`: their sight and how many sides each gather names.
         let sides = |place: &dyn Fn(glam::Vec3) -> bool, up: f32| {
             let patches = scene.patches.patches.iter().enumerate().filter(|(_, p)| place(p.centroid) && p.normal.z * up > 0.5);
-            patches.map(|(p, patch)| sight[side_of(p as u32, patch.normal.z * up < 0.0) as usize]).collect::<Vec<_>>()
+            let sides: Vec<usize> = patches.map(|(p, patch)| side_of(p as u32, patch.normal.z * up < 0.0) as usize).collect();
+            assert!(!sides.is_empty());
+            sides.into_iter().map(|side| (sight[side], model.side_gather(side).form_factors.len())).collect::<Vec<_>>()
         };
         // The probes from the sensor may miss a corner patch of the ceiling;
         // the ceiling's middle, over the sensor, is seen.
         let ceiling = sides(&|c| (c.x - 2.0).abs() < 1.0 && (c.y - 2.0).abs() < 1.0 && c.z > 2.9, -1.0);
         let floor = sides(&|c| c.x < 4.0 && c.z < 0.1, 1.0);
         let other_floor = sides(&|c| c.x > 5.0 && c.z < 0.1, 1.0);
-        assert!(!ceiling.is_empty() && ceiling.iter().all(|&s| s == Sight::Seen), "{ceiling:?}");
-        assert!(!floor.is_empty() && floor.iter().all(|&s| s == Sight::SeenBySeen), "{floor:?}");
-        assert!(!other_floor.is_empty() && other_floor.iter().all(|&s| s == Sight::Farther), "{other_floor:?}");
-        assert_eq!(Sight::Seen.ray_share(0.5, 0.25), 1.0, "a seen side keeps its rays wherever it lies");
-        assert_eq!((Sight::SeenBySeen.ray_share(1.0, 0.25), Sight::Farther.ray_share(1.0, 0.25)), (0.25, 0.0625));
-        assert_eq!(Sight::Farther.ray_share(1.0, 1.0), 1.0, "a picture keeps every side's rays");
+        assert!(ceiling.iter().all(|&(s, named)| s == Sight::SEEN && named > 16), "{ceiling:?}");
+        assert!(floor.iter().all(|&(s, named)| s == Sight(1) && named <= 16), "{floor:?}");
+        assert!(other_floor.iter().all(|&(s, named)| s == Sight::FARTHER && named <= 1), "{other_floor:?}");
+        assert_eq!(Sight::SEEN.ray_share(0.5, 0.25), 1.0, "a seen side keeps its rays wherever it lies");
+        assert_eq!([1, 2, 3].map(|steps| Sight(steps).ray_share(1.0, 0.25)), [0.25, 0.0625, 0.015625]);
+        assert_eq!(Sight(2).ray_share(0.03, 0.25), 0.03, "no more than where it lies allows");
+        assert_eq!(Sight::FARTHER.ray_share(1.0, 1.0), 1.0, "a picture keeps every side's rays");
     }
 }

@@ -33,9 +33,10 @@ pub struct LightSettings {
     pub sky_rays_per_sensor: usize,
     /// The share of the patch rays (hemisphere and aimed) at most that a
     /// side no sensor sees traces, where a scene has sensors (farther from
-    /// them, the sizing's smaller share: `PatchSizing::ray_share`), and its
-    /// square for a side that no seen side sees either. Such a side reaches
-    /// the sensors only after one more bounce (or two), where its noise
+    /// them, the sizing's smaller share: `PatchSizing::ray_share`), and
+    /// this share again for each bounce farther its light is from the
+    /// sensors (up to three: a sixty-fourth). Such a side reaches the
+    /// sensors only after one more bounce (or more), where its noise
     /// averages over the many sides each seen side gathers from. At a
     /// quarter, AC20-Institute-Var-2 with one office's sensors precomputes
     /// in 4.5 s instead of 7.6 s (2 cores), and the office's mean reading
