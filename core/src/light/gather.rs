@@ -377,9 +377,12 @@ impl LightModel {
             let these: Vec<usize> = (0..sight.len()).filter(|&side| sight[side] == Sight(step)).collect();
             let traced = par_map(model.settings.threads, these.len(), |k| gather_side(these[k], &sight));
             for (side, gather) in these.into_iter().zip(traced) {
-                for &(next, _) in &gather.0.form_factors {
-                    if sight[next as usize] == Sight::FARTHER {
-                        sight[next as usize] = Sight(step + 1);
+                // What the last steps name is farther anyway.
+                if step + 1 < Sight::FARTHER.0 {
+                    for &(next, _) in &gather.0.form_factors {
+                        if sight[next as usize] == Sight::FARTHER {
+                            sight[next as usize] = Sight(step + 1);
+                        }
                     }
                 }
                 gathers[side] = gather;
