@@ -75,6 +75,30 @@ impl Sight {
             Sight(steps) => where_it_lies.min(unseen.powi(i32::from(steps))),
         }
     }
+
+    /// Per patch side: seen where `seen`, else farther until a gather
+    /// nearer names it ([`Sight::mark_named`]).
+    fn from_seen(seen: &[bool]) -> Vec<Sight> {
+        seen.iter().map(|&seen| if seen { Sight::SEEN } else { Sight::FARTHER }).collect()
+    }
+
+    /// The sides `step` bounces from the sensors.
+    fn sides_at(sight: &[Sight], step: u8) -> Vec<usize> {
+        (0..sight.len()).filter(|&side| sight[side] == Sight(step)).collect()
+    }
+
+    /// Marks the sides that `gather`, of a side `step` bounces from the
+    /// sensors, names as a bounce farther, where no nearer gather did.
+    fn mark_named(sight: &mut [Sight], step: u8, gather: &Gather) {
+        // What the last steps name is farther anyway.
+        if step + 1 < Sight::FARTHER.0 {
+            for &(next, _) in &gather.form_factors {
+                if sight[next as usize] == Sight::FARTHER {
+                    sight[next as usize] = Sight(step + 1);
+                }
+            }
+        }
+    }
 }
 
 /// Where a receiver's hemisphere light comes from: the **daylight
@@ -371,20 +395,13 @@ impl LightModel {
             gather
         };
         // Step by step: the sides a step away, gathered, name those one more.
-        let mut sight: Vec<Sight> = seen.iter().map(|&seen| if seen { Sight::SEEN } else { Sight::FARTHER }).collect();
+        let mut sight = Sight::from_seen(&seen);
         let mut gathers = vec![(nothing.clone(), false); patches.len() * 2];
         for step in 0..=Sight::FARTHER.0 {
-            let these: Vec<usize> = (0..sight.len()).filter(|&side| sight[side] == Sight(step)).collect();
+            let these = Sight::sides_at(&sight, step);
             let traced = par_map(model.settings.threads, these.len(), |k| gather_side(these[k], &sight));
             for (side, gather) in these.into_iter().zip(traced) {
-                // What the last steps name is farther anyway.
-                if step + 1 < Sight::FARTHER.0 {
-                    for &(next, _) in &gather.0.form_factors {
-                        if sight[next as usize] == Sight::FARTHER {
-                            sight[next as usize] = Sight(step + 1);
-                        }
-                    }
-                }
+                Sight::mark_named(&mut sight, step, &gather.0);
                 gathers[side] = gather;
             }
         }
@@ -781,16 +798,10 @@ mod tests {
         let settings = LightSettings { rays_per_patch: 64, window_rays_per_patch: 16, ..LightSettings::default() };
         let model = LightModel::precompute(scene.clone(), settings).unwrap();
         // Each side's steps from the sensors, as the gathers found them.
-        let seen = model.seen_by_sensors();
-        let mut sight: Vec<Sight> = seen.iter().map(|&seen| if seen { Sight::SEEN } else { Sight::FARTHER }).collect();
+        let mut sight = Sight::from_seen(&model.seen_by_sensors());
         for step in 0..Sight::FARTHER.0 {
-            let these: Vec<usize> = (0..sight.len()).filter(|&side| sight[side] == Sight(step)).collect();
-            for side in these {
-                for &(next, _) in &model.side_gather(side).form_factors {
-                    if sight[next as usize] == Sight::FARTHER {
-                        sight[next as usize] = Sight(step + 1);
-                    }
-                }
+            for side in Sight::sides_at(&sight, step) {
+                Sight::mark_named(&mut sight, step, model.side_gather(side));
             }
         }
         // The inward sides of the faces with their middles in `place`,
