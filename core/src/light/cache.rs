@@ -26,7 +26,7 @@ use crate::sky::SkyPatches;
 
 const MAGIC: &[u8; 8] = b"HELIOLT\0";
 /// Bump when the model or its layout changes.
-const FORMAT: u32 = 16;
+const FORMAT: u32 = 17;
 
 /// What happened to the cache.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -655,6 +655,13 @@ impl Writer {
         self.0.extend_from_slice(&v.to_le_bytes());
     }
 
+    /// Flags, eight to a byte (their count is the reader's to know).
+    pub fn flags(&mut self, flags: &[bool]) {
+        for byte in flags.chunks(8) {
+            self.u8(byte.iter().enumerate().fold(0, |b, (k, &f)| b | (u8::from(f) << k)));
+        }
+    }
+
     pub fn vec3(&mut self, v: DVec3) {
         self.f64(v.x);
         self.f64(v.y);
@@ -761,6 +768,12 @@ impl Reader<'_> {
         self.take(8).map(|b| u64::from_le_bytes(b.try_into().expect("8 bytes")))
     }
 
+    /// `count` flags as [`Writer::flags`] wrote them.
+    pub fn flags(&mut self, count: usize) -> Option<Vec<bool>> {
+        let bytes = self.take(count.div_ceil(8))?;
+        Some((0..count).map(|k| bytes[k / 8] >> (k % 8) & 1 == 1).collect())
+    }
+
     pub fn vec3(&mut self) -> Option<DVec3> {
         Some(DVec3::new(self.f64()?, self.f64()?, self.f64()?))
     }
@@ -806,8 +819,9 @@ impl Reader<'_> {
     }
 }
 
-/// What a model gathered: per patch side, and its sensors.
-type Gathered = (Vec<Arc<Gather>>, Arc<Vec<SensorGeometry>>);
+/// What a model gathered: per patch side, and its sensors; and which of
+/// each are open to the sun ([`super::openings::Spaces`]).
+type Gathered = (Vec<Arc<Gather>>, Arc<Vec<SensorGeometry>>, (Vec<bool>, Vec<bool>));
 
 impl LightModel {
     /// The gathered data, for the cache.
@@ -822,6 +836,8 @@ impl LightModel {
         self.side_gathers.iter().for_each(|g| w.gather(g));
         w.u32(self.sensors.len() as u32);
         self.sensors.iter().for_each(|s| s.write(&mut w));
+        w.flags(&self.open_sides);
+        w.flags(&self.open_sensors);
         w.0
     }
 
@@ -839,9 +855,9 @@ impl LightModel {
             let (triangles, owner) = LightModel::shadow_casters(scene);
             Some(Arc::new(Tracer::from_bytes(tracer_bytes, &triangles, &owner)?))
         };
-        let (side_gathers, sensors) = Self::read_payload(scene, settings, rest)?;
+        let (side_gathers, sensors, (open_sides, open_sensors)) = Self::read_payload(scene, settings, rest)?;
         let empty = Self::empty(scene.clone(), settings, beside, stored);
-        Some(LightModel { side_gathers, sensors, ..empty }.sharing(beside))
+        Some(LightModel { side_gathers, sensors, open_sides, open_sensors, ..empty }.sharing(beside))
     }
 
     /// The side gathers and sensor geometries a payload holds after its
@@ -858,6 +874,7 @@ impl LightModel {
             return None;
         }
         let sensors = (0..sensor_count).map(|_| SensorGeometry::read(&mut r)).collect::<Option<Vec<_>>>()?;
+        let open = (r.flags(sides)?, r.flags(sensor_count)?);
         let bins = (scene.windows.len() as u32 + 1) * 2 * SkyPatches::reinhart(settings.sky_subdivision).len() as u32;
         let patch_sides = sides as u32;
         let fits = |g: &Gather| g.daylight_coefficients.iter().all(|b| b.0 < bins) && g.form_factors.iter().all(|s| s.0 < patch_sides);
@@ -867,7 +884,7 @@ impl LightModel {
         }
         let nothing = Arc::new(Gather::default());
         let shared = |g: Gather| if g == *nothing { nothing.clone() } else { Arc::new(g) };
-        Some((side_gathers.into_iter().map(shared).collect(), Arc::new(sensors)))
+        Some((side_gathers.into_iter().map(shared).collect(), Arc::new(sensors), open))
     }
 
     /// This model (read from the cache) with what it has alike with

@@ -15,6 +15,7 @@ use glam::DVec3;
 
 use super::bvh::Tracer;
 use super::landings::Landings;
+use super::openings::{LEAST_JOINING_SHARE, SPACE_MEMBER, Spaces};
 use super::sampling::{self, Rng, cosine_directions, sample_area, with_cumulative_areas};
 use super::{LightModel, LightSettings, MAX_GLASS_DEPTH, MIN_WEIGHT, SURFACE_OFFSET, Surface, par_map, side_of};
 use crate::parallel::par_join;
@@ -253,6 +254,18 @@ struct SideHit {
     side: u32,
     weight: f64,
     point: DVec3,
+    /// Whether the ray crossed a window on its way.
+    through_window: bool,
+}
+
+/// The sides `hits` (of `rays` rays) met crossing no window, each once,
+/// where they are at least [`LEAST_JOINING_SHARE`] of the rays: what joins
+/// a side to its space ([`Spaces`]).
+fn unglazed_sides(hits: &[SideHit], rays: usize) -> Vec<u32> {
+    let mut sides: Vec<u32> = hits.iter().filter(|h| !h.through_window).map(|h| h.side).collect();
+    sides.sort_unstable();
+    let least = (LEAST_JOINING_SHARE * rays as f64).ceil() as usize;
+    sides.chunk_by(|a, b| a == b).filter(|run| run.len() >= least).map(|run| run[0]).collect()
 }
 
 impl Gather {
@@ -348,7 +361,9 @@ impl LightModel {
     /// the same is that model's, shared, not traced again, and so are the
     /// sensors where no side traced again changes whether the sun may
     /// reach it (their landings keep such sides only): each is what a
-    /// trace would give, bit for bit.
+    /// trace would give, bit for bit. The rays that cross no window join
+    /// the sides into spaces, and a space with an opening to the sky makes
+    /// its sides open to the sun ([`Spaces`]).
     pub(super) fn gathered(mut self, dark: &[bool], beside: Option<&LightModel>, progress: &(dyn Fn(f64) + Sync)) -> Self {
         let model = &mut self;
         let patches = &model.scene.patches.patches;
@@ -377,17 +392,19 @@ impl LightModel {
             (!dark[side]).then(|| sight[side].ray_share(model.ray_shares[side / 2], unseen_share))
         };
         let nothing = Arc::new(Gather::default());
+        // Each side's gather, whether it was traced here, and the sides its
+        // rays met crossing no window (none where `beside`'s is shared).
         let gather_side = |side: usize, sight: &[Sight]| {
             let own = share(&model.settings, side, sight);
             let gather = match (own, beside) {
-                (_, Some(b)) if share(&b.settings, side, sight) == own => (b.side_gathers[side].clone(), false),
-                (None, _) => (nothing.clone(), false),
+                (_, Some(b)) if share(&b.settings, side, sight) == own => (b.side_gathers[side].clone(), false, Vec::new()),
+                (None, _) => (nothing.clone(), false, Vec::new()),
                 (Some(own), beside) => {
-                    let traced = model.gather_patch_side(side, &targets, own);
+                    let (traced, unglazed) = model.gather_patch_side(side, &targets, own);
                     match beside.map(|b| &b.side_gathers[side]) {
                         // Glass gathers nothing, whatever its rays.
-                        Some(theirs) if **theirs == traced => (theirs.clone(), true),
-                        _ => (Arc::new(traced), true),
+                        Some(theirs) if **theirs == traced => (theirs.clone(), true, unglazed),
+                        _ => (Arc::new(traced), true, unglazed),
                     }
                 }
             };
@@ -397,28 +414,48 @@ impl LightModel {
         // Step by step: the sides a step away, gathered, name those one more.
         let mut sight = Sight::from_seen(&seen);
         let mut gathers = vec![(nothing.clone(), false); patches.len() * 2];
+        let mut spaces = Spaces::new(gathers.len());
+        let finest = model.scene.patch_sizing.finest;
+        let joins = |side: usize| patches[side / 2].area >= SPACE_MEMBER * finest * finest;
         for step in 0..=Sight::FARTHER.0 {
             let these = Sight::sides_at(&sight, step);
             let traced = par_map(model.settings.threads, these.len(), |k| gather_side(these[k], &sight));
-            for (side, gather) in these.into_iter().zip(traced) {
-                Sight::mark_named(&mut sight, step, &gather.0);
-                gathers[side] = gather;
+            for (side, (gather, fresh, unglazed)) in these.into_iter().zip(traced) {
+                Sight::mark_named(&mut sight, step, &gather);
+                // A side shared with `beside` brings no rays: an open space of
+                // `beside`'s it was in stays open.
+                let was_open = !fresh && beside.is_some_and(|b| b.open_sides[side]) && !model.sees_open_sky(&gather);
+                let opening = if was_open { f64::INFINITY } else { model.sky_opening(side, &gather) };
+                if joins(side) {
+                    let members: Vec<u32> = unglazed.into_iter().filter(|&other| joins(other as usize)).collect();
+                    spaces.join(side as u32, opening, &members);
+                }
+                gathers[side] = (gather, fresh);
             }
         }
+        // Open: a side whose own rays saw the open sky, or one in an open space.
+        let own = gathers.iter().map(|(gather, _)| model.sees_open_sky(gather));
+        model.open_sides = spaces.open_sides().into_iter().zip(own).map(|(space, own)| space || own).collect();
         let traced: Vec<bool>;
         (model.side_gathers, traced) = gathers.into_iter().unzip();
         let same_sunlit_sides = |b: &LightModel| {
-            (0..traced.len() as u32).all(|side| !traced[side as usize] || model.may_be_sunlit(side) == b.may_be_sunlit(side))
+            b.open_sides == model.open_sides
+                && (0..traced.len() as u32).all(|side| !traced[side as usize] || model.may_be_sunlit(side) == b.may_be_sunlit(side))
         };
-        let shared_sensors = beside.filter(|b| same_sunlit_sides(b)).map(|b| b.sensors.clone());
-        model.sensors = shared_sensors.unwrap_or_else(|| {
+        if let Some(b) = beside.filter(|b| same_sunlit_sides(b)) {
+            (model.sensors, model.open_sensors) = (b.sensors.clone(), b.open_sensors.clone());
+        } else {
             let sensors = model.scene.sensors.clone();
-            Arc::new(par_map(model.settings.threads, sensors.len(), |i| {
-                let geometry = model.sensor_geometry(i, &sensors[i], &targets);
+            let traced = par_map(model.settings.threads, sensors.len(), |i| {
+                let (geometry, unglazed) = model.sensor_geometry(i, &sensors[i], &targets);
                 tick();
-                geometry
-            }))
-        });
+                let open = model.sees_open_sky(&geometry.gather) || unglazed.iter().any(|&side| model.open_sides[side as usize]);
+                (geometry, open)
+            });
+            let geometries;
+            (geometries, model.open_sensors) = traced.into_iter().unzip();
+            model.sensors = Arc::new(geometries);
+        }
         self
     }
 
@@ -452,7 +489,9 @@ impl LightModel {
                     reflected,
                 };
                 match self.surface_of_patch(hit.patch) {
-                    Surface::Diffuse(_) => hits.push(SideHit { side: side_of(hit.patch, cos > 0.0), weight, point }),
+                    Surface::Diffuse(_) => {
+                        hits.push(SideHit { side: side_of(hit.patch, cos > 0.0), weight, point, through_window: window.is_some() })
+                    }
                     Surface::Panel(group) if depth < MAX_GLASS_DEPTH => {
                         let side = side_of(hit.patch, cos > 0.0);
                         if self.panel_room_side(hit.patch, group) == Some(side) {
@@ -460,7 +499,7 @@ impl LightModel {
                             // (what it reflects back) and the panel's light along
                             // the ray, made at relight from the sky its windows
                             // see; what lies beyond is not seen through a panel.
-                            hits.push(SideHit { side, weight, point });
+                            hits.push(SideHit { side, weight, point, through_window: window.is_some() });
                             let window = self.window_of_surface[self.scene.patches.patches[hit.patch as usize].surface as usize];
                             if keep_sky(Way { window, reflected }) {
                                 let key = SkyKey { window, bin: self.sky_bins.sphere_bin(dir) as u32 };
@@ -500,7 +539,8 @@ impl LightModel {
     /// The hemisphere rays keep the sky only where no aimed ray could have
     /// drawn its path (through a window not aimed at, or after glass
     /// turned it back), so every path to the sky is counted once.
-    fn gather_patch_side(&self, side: usize, targets: &[WindowTarget], share: f64) -> Gather {
+    /// Also returns the sides its rays met crossing no window.
+    fn gather_patch_side(&self, side: usize, targets: &[WindowTarget], share: f64) -> (Gather, Vec<u32>) {
         let patch_index = side / 2;
         let gathers = match self.surface_of_patch(patch_index as u32) {
             Surface::Diffuse(_) => true,
@@ -508,7 +548,7 @@ impl LightModel {
             Surface::Glass(_) => false,
         };
         if !gathers {
-            return Gather::default();
+            return (Gather::default(), Vec::new());
         }
         let patch = &self.scene.patches.patches[patch_index];
         let normal = patch.normal.as_dvec3() * if side % 2 == 1 { -1.0 } else { 1.0 };
@@ -530,7 +570,7 @@ impl LightModel {
         }
         let aiming = Aiming { normal, aimed: &aimed, targets, rays: window_rays, hemisphere };
         self.aim_at_windows(&aiming, &mut rng, Eyes::Spread { triangles: &triangles, lift: normal * SURFACE_OFFSET }, &mut coefficients);
-        Gather::from_raw(coefficients, &hits, hemisphere)
+        (Gather::from_raw(coefficients, &hits, hemisphere), unglazed_sides(&hits, hemisphere))
     }
 
     /// Traces `aiming.rays` rays aimed at its windows from `eyes`, adding
@@ -672,7 +712,8 @@ impl LightModel {
     /// patch side's, the sky through the windows it sees comes from rays
     /// aimed at them ([`LightSettings::window_rays_per_sensor`]), the rest
     /// from its hemisphere rays.
-    fn sensor_geometry(&self, index: usize, sensor: &Sensor, targets: &[WindowTarget]) -> SensorGeometry {
+    /// Also returns the sides its rays met crossing no window.
+    fn sensor_geometry(&self, index: usize, sensor: &Sensor, targets: &[WindowTarget]) -> (SensorGeometry, Vec<u32>) {
         let normal = sensor.normal.as_dvec3();
         let points = place_sensor(self.tracer(), sensor, 4);
         let sun_points = match sensor.size {
@@ -709,7 +750,7 @@ impl LightModel {
         let rays = bounce_rays + trace(more_per_point, &mut coefficients, &mut hits, &mut rng);
         let aiming = Aiming { normal, aimed: &aimed, targets, rays: self.settings.window_rays_per_sensor, hemisphere: rays };
         self.aim_at_windows(&aiming, &mut rng, Eyes::Fixed(&points), &mut coefficients);
-        SensorGeometry::new(Gather::from_raw(coefficients, &hits, rays), sun_points, normal, landings)
+        (SensorGeometry::new(Gather::from_raw(coefficients, &hits, rays), sun_points, normal, landings), unglazed_sides(&hits, rays))
     }
 }
 
@@ -774,6 +815,63 @@ mod tests {
             quad("wall", [[xa, 0.0, za], [xa, 0.0, zb], [xb, 0.0, zb], [xb, 0.0, za]]);
         }
         quad("glass", [[1.0, 0.0, 1.0], [1.0, 0.0, 2.0], [3.0, 0.0, 2.0], [3.0, 0.0, 1.0]]);
+    }
+
+    /// A room with a doorway and no window, and beside it a room closed but
+    /// for its window: the sun through the doorway lights the floor of the
+    /// first even where a side's own few rays missed the doorway (each side
+    /// joins the doorway's space), and the second room stays enclosed.
+    #[test]
+    fn the_sun_through_a_doorway_reaches_the_sides_whose_own_rays_missed_it() {
+        let dir = std::env::temp_dir().join(format!("heliodon-doorway-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut obj = String::from("mtllib m.mtl\n");
+        // 4 × 4 × 3 m, wound inward; the east wall has a doorway 1 m wide
+        // (y 1.5–2.5) and 2 m high.
+        let mut quad = |corners: [[f64; 3]; 4]| {
+            let _ = writeln!(obj, "usemtl wall");
+            for [x, y, z] in corners {
+                let _ = writeln!(obj, "v {x} {y} {z}");
+            }
+            let _ = writeln!(obj, "f -4 -3 -2 -1");
+        };
+        quad([[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 4.0, 0.0], [0.0, 4.0, 0.0]]);
+        quad([[0.0, 0.0, 3.0], [0.0, 4.0, 3.0], [4.0, 4.0, 3.0], [4.0, 0.0, 3.0]]);
+        quad([[0.0, 4.0, 0.0], [4.0, 4.0, 0.0], [4.0, 4.0, 3.0], [0.0, 4.0, 3.0]]);
+        quad([[0.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 4.0, 3.0], [0.0, 0.0, 3.0]]);
+        quad([[0.0, 0.0, 0.0], [0.0, 0.0, 3.0], [4.0, 0.0, 3.0], [4.0, 0.0, 0.0]]);
+        for (ya, yb, za, zb) in [(0.0, 1.5, 0.0, 3.0), (2.5, 4.0, 0.0, 3.0), (1.5, 2.5, 2.0, 3.0)] {
+            quad([[4.0, ya, za], [4.0, ya, zb], [4.0, yb, zb], [4.0, yb, za]]);
+        }
+        room(&mut obj, -6.0);
+        std::fs::write(dir.join("m.obj"), obj).unwrap();
+        std::fs::write(dir.join("m.mtl"), "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.8\n").unwrap();
+        let scene = "[site]\nlatitude = 45.0\nlongitude = 0.0\ntimezone = 0.0\n[model]\nobj = \"m.obj\"\n";
+        std::fs::write(dir.join("scene.toml"), scene).unwrap();
+        let scene = Arc::new(load_scene(&dir.join("scene.toml"), &PanelCatalog::new()).unwrap().scene);
+        std::fs::remove_dir_all(&dir).ok();
+        // Few rays: a floor side sees the doorway in about one ray of twenty.
+        let settings = LightSettings { rays_per_patch: 24, window_rays_per_patch: 8, ..LightSettings::default() };
+        let model = LightModel::precompute(scene.clone(), settings).unwrap();
+        // The sun from the east, 30° up: all it sends through the doorway
+        // lands on the floor, between x = 0.54 and 4 m.
+        let to_sun = DVec3::new(30f64.to_radians().cos(), 0.0, 30f64.to_radians().sin());
+        let beams = model.sun_beams(&crate::sky::SunSource::unit(to_sun));
+        let on_sides = model.sun_on_sides(&beams, &|side| model.sun_samples(side), false, None);
+        let inward_floor = |x: std::ops::Range<f32>| {
+            (scene.patches.patches.iter().enumerate()).filter(move |(_, p)| x.contains(&p.centroid.x) && p.centroid.z < 0.1).map(
+                |(p, patch)| {
+                    let side = side_of(p as u32, patch.normal.z < 0.0) as usize;
+                    (side, f64::from(patch.area))
+                },
+            )
+        };
+        let on_floor: f64 = inward_floor(0.0..4.0).map(|(side, area)| on_sides.irradiance[side] * area).sum();
+        let through_doorway = beams[0].normal_irradiance * 2.0 * to_sun.x;
+        let missed = inward_floor(0.0..4.0).filter(|&(side, _)| !model.sees_open_sky(model.side_gather(side))).count();
+        assert!(missed > 10, "the test needs floor sides whose own rays missed the doorway: {missed}");
+        assert!((on_floor / through_doorway - 1.0).abs() < 0.03, "{on_floor} W on the floor, {through_doorway} W through the doorway");
+        assert!(inward_floor(-6.0..-2.0).all(|(side, _)| !model.side_is_open(side)), "the room closed but for its window is enclosed");
     }
 
     /// Two rooms side by side, each with its window, the sensor in the

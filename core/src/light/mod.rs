@@ -137,6 +137,13 @@ pub struct LightModel {
     /// one refines where they are the same ([`cache::precompute_cached_beside`]).
     side_gathers: Vec<Arc<Gather>>,
     sensors: Arc<Vec<SensorGeometry>>,
+    /// Per patch side, whether the sun may reach it without crossing a
+    /// window: its space has an opening to the open sky
+    /// ([`openings::Spaces`]).
+    open_sides: Vec<bool>,
+    /// Per sensor, the same: it saw the open sky, or an open side with no
+    /// window between.
+    open_sensors: Vec<bool>,
     /// [`cache::key`] of `scene` and `settings`, found once: the cached
     /// tables made from the model key on it, and finding it hashes every
     /// triangle of the model and of its patches.
@@ -314,6 +321,8 @@ impl LightModel {
             surfaces,
             side_gathers: Vec::new(),
             sensors: Arc::default(),
+            open_sides: Vec::new(),
+            open_sensors: Vec::new(),
             cache_key: std::sync::OnceLock::new(),
             landings_on_sides: std::sync::OnceLock::new(),
         };
@@ -343,10 +352,24 @@ impl LightModel {
         self.patch_normal(side / 2) * if side % 2 == 1 { -1.0 } else { 1.0 }
     }
 
-    /// Whether some gather ray of the side left straight to the open sky or
-    /// ground, through no window.
+    /// Whether the sun may reach the side without crossing a window: its
+    /// space is open ([`openings::Spaces`]).
     fn side_is_open(&self, side: usize) -> bool {
-        self.sees_open_sky(&self.side_gathers[side])
+        self.open_sides[side]
+    }
+
+    /// The opening (m²) through which side `side` saw the open sky (through
+    /// no window, upward, whence the sun comes): its area times the share
+    /// of its rays ([`openings::Spaces`]).
+    fn sky_opening(&self, side: usize, gather: &Gather) -> f64 {
+        let sky_bins = self.sky_bins.len() as u32;
+        let share: f64 = (gather.daylight_coefficients.iter())
+            .map(|&(k, w)| (SkyKey::unpack(k, self.bin_count()), w))
+            .take_while(|(key, _)| key.window.is_none())
+            .filter(|(key, _)| key.bin < sky_bins)
+            .map(|(_, w)| f64::from(w))
+            .sum();
+        f64::from(self.scene.patches.patches[side / 2].area) * share
     }
 
     /// Whether some ray of `gather` left straight to the open sky or ground

@@ -299,13 +299,14 @@ impl LightModel {
     }
 
     /// Sensor `index`'s direct sun (W/m², averaged over its sun points).
-    /// An enclosed sensor (no gather ray reached the open sky) is traced
-    /// only along beams that may pass a window, as sides are.
+    /// An enclosed sensor (neither its rays nor the sides they met with no
+    /// window between are open to the sky) is traced only along beams that
+    /// may pass a window, as sides are.
     pub(super) fn sensor_direct_sun(&self, index: usize, sun: &SensorsSun) -> f64 {
         let through_data: f64 = self.sensor_measured_sun(index, sun.measured).iter().map(|w| w.1).sum();
         let beams = &sun.beams[..];
         let geometry = &self.sensors[index];
-        let reach = if self.sees_open_sky(&geometry.gather) || beams.is_empty() {
+        let reach = if self.open_sensors[index] || beams.is_empty() {
             Reach::Open(Shadows::default())
         } else {
             let centre = geometry.sun_points.iter().sum::<DVec3>() / geometry.sun_points.len() as f64;
