@@ -84,6 +84,11 @@ pub(super) struct SensorsSun<'a> {
 /// the study.
 const SHADOWS_FROM_RAYS: usize = 16;
 
+/// The most corners of a patch [`LightModel::sun_reaches_some_point`] asks.
+const PROBED_CORNERS: usize = 8;
+/// The points spread over a patch it asks besides.
+const PROBED_POINTS: usize = 16;
+
 /// The most triangles a beam's rays from a side test one by one (three
 /// dot products each, where a traversal of the BVH costs a ray about as
 /// much as fifty).
@@ -264,9 +269,12 @@ impl LightModel {
             return Reach::None;
         }
         let normal = self.side_normal(side as u32);
+        // A side open only by its space, with many points to trace, first
+        // asks a few whether the sun comes in at all.
+        let open_here = || !shadows || self.sees_open_sky(&self.side_gathers[side]) || self.sun_reaches_some_point(side, normal, beams);
         if !beams.iter().any(|b| normal.dot(b.to_light) > 0.0) {
             Reach::None
-        } else if self.side_is_open(side) {
+        } else if self.side_is_open(side) && open_here() {
             Reach::Open(self.side_shadows(side, normal, beams, shadows))
         } else {
             match along.ways_in(side / 2) {
@@ -274,6 +282,34 @@ impl LightModel {
                 ways => Reach::Through(ways, self.side_shadows(side, normal, beams, shadows)),
             }
         }
+    }
+
+    /// Whether the sun itself reaches a few points of `side`'s patch: its
+    /// corners (pulled a tenth toward its middle), its middle and
+    /// [`PROBED_POINTS`] spread over it. A side open only by its space takes
+    /// the sun through an opening a doorway wide, whose sun patch on it
+    /// covers some of them; the landings and samples of a side the sun
+    /// misses are not traced hour by hour. ExampleHOM's year: 66 → 37 s
+    /// (before the spaces 28 s), its readings at an instant 0.05% lower on
+    /// average (at most 0.55%); with the corners and middle alone 32 s and
+    /// 0.3% lower (at most 4%).
+    fn sun_reaches_some_point(&self, side: usize, normal: DVec3, beams: &[SunBeam]) -> bool {
+        let patch = &self.scene.patches.patches[side / 2];
+        let middle = patch.centroid.as_dvec3();
+        let mut corners: Vec<DVec3> = Vec::new();
+        for triangle in &self.scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize] {
+            for vertex in triangle.map(|v| v.as_dvec3()) {
+                if corners.len() < PROBED_CORNERS && !corners.iter().any(|c| c.distance_squared(vertex) < 1e-8) {
+                    corners.push(vertex);
+                }
+            }
+        }
+        let triangles = self.patch_triangles(side / 2);
+        let mut rng = Rng::seeded(5, self.settings.seed, side as u64);
+        let spread: Vec<DVec3> = (0..PROBED_POINTS).map(|_| sample_area(&triangles, &mut rng)).collect();
+        let probes = corners.into_iter().map(|c| c + (middle - c) * 0.1).chain(std::iter::once(middle)).chain(spread);
+        let sun: Vec<&SunBeam> = beams.iter().filter(|b| b.panel_group.is_none() && normal.dot(b.to_light) > 0.0).collect();
+        probes.map(|p| p + normal * SURFACE_OFFSET).any(|p| sun.iter().any(|beam| self.beam_irradiance(p, normal, beam, None) > 0.0))
     }
 
     /// The triangles each beam's rays from `side` may meet ([`Shadows`]);
