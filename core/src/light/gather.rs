@@ -415,6 +415,7 @@ impl LightModel {
         let mut sight = Sight::from_seen(&seen);
         let mut gathers = vec![(nothing.clone(), false); patches.len() * 2];
         let mut spaces = Spaces::new(gathers.len());
+        let mut own_sky = vec![false; gathers.len()];
         let finest = model.scene.patch_sizing.finest;
         let joins = |side: usize| patches[side / 2].area >= SPACE_MEMBER * finest * finest;
         for step in 0..=Sight::FARTHER.0 {
@@ -422,20 +423,21 @@ impl LightModel {
             let traced = par_map(model.settings.threads, these.len(), |k| gather_side(these[k], &sight));
             for (side, (gather, fresh, unglazed)) in these.into_iter().zip(traced) {
                 Sight::mark_named(&mut sight, step, &gather);
-                // A side shared with `beside` brings no rays: an open space of
-                // `beside`'s it was in stays open.
-                let was_open = !fresh && beside.is_some_and(|b| b.open_sides[side]) && !model.sees_open_sky(&gather);
-                let opening = if was_open { f64::INFINITY } else { model.sky_opening(side, &gather) };
+                let sees_sky = model.sees_open_sky(&gather);
                 if joins(side) {
+                    // A side shared with `beside` brings no rays: an open space
+                    // of `beside`'s it was in stays open.
+                    let was_open = !fresh && !sees_sky && beside.is_some_and(|b| b.open_sides[side]);
+                    let opening = if was_open { f64::INFINITY } else { model.sky_opening(side, &gather) };
                     let members: Vec<u32> = unglazed.into_iter().filter(|&other| joins(other as usize)).collect();
                     spaces.join(side as u32, opening, &members);
                 }
+                own_sky[side] = sees_sky;
                 gathers[side] = (gather, fresh);
             }
         }
         // Open: a side whose own rays saw the open sky, or one in an open space.
-        let own = gathers.iter().map(|(gather, _)| model.sees_open_sky(gather));
-        model.open_sides = spaces.open_sides().into_iter().zip(own).map(|(space, own)| space || own).collect();
+        model.open_sides = spaces.open_sides().into_iter().zip(own_sky).map(|(space, own)| space || own).collect();
         let traced: Vec<bool>;
         (model.side_gathers, traced) = gathers.into_iter().unzip();
         let same_sunlit_sides = |b: &LightModel| {

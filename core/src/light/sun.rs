@@ -297,17 +297,20 @@ impl LightModel {
         let patch = &self.scene.patches.patches[side / 2];
         let middle = patch.centroid.as_dvec3();
         let mut corners: Vec<DVec3> = Vec::new();
-        for triangle in &self.scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize] {
-            for vertex in triangle.map(|v| v.as_dvec3()) {
-                if corners.len() < PROBED_CORNERS && !corners.iter().any(|c| c.distance_squared(vertex) < 1e-8) {
-                    corners.push(vertex);
-                }
+        let vertices = self.scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize].iter().flatten();
+        for vertex in vertices.map(|v| v.as_dvec3()) {
+            if corners.len() == PROBED_CORNERS {
+                break;
+            }
+            if !corners.iter().any(|c| c.distance_squared(vertex) < 1e-8) {
+                corners.push(vertex);
             }
         }
-        let triangles = self.patch_triangles(side / 2);
+        // The spread points are drawn only if no corner nor the middle sees the sun.
+        let triangles = std::cell::OnceCell::new();
         let mut rng = Rng::seeded(5, self.settings.seed, side as u64);
-        let spread: Vec<DVec3> = (0..PROBED_POINTS).map(|_| sample_area(&triangles, &mut rng)).collect();
-        let probes = corners.into_iter().map(|c| c + (middle - c) * 0.1).chain(std::iter::once(middle)).chain(spread);
+        let spread = std::iter::repeat_with(|| sample_area(triangles.get_or_init(|| self.patch_triangles(side / 2)), &mut rng));
+        let probes = corners.into_iter().map(|c| c + (middle - c) * 0.1).chain(std::iter::once(middle)).chain(spread.take(PROBED_POINTS));
         let sun: Vec<&SunBeam> = beams.iter().filter(|b| b.panel_group.is_none() && normal.dot(b.to_light) > 0.0).collect();
         probes.map(|p| p + normal * SURFACE_OFFSET).any(|p| sun.iter().any(|beam| self.beam_irradiance(p, normal, beam, None) > 0.0))
     }
