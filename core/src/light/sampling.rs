@@ -47,22 +47,54 @@ pub fn frame(n: DVec3) -> (DVec3, DVec3) {
 /// `count` cosine-weighted directions about `n`, stratified on a grid of
 /// about √count × √count cells (the remainder jittered at random).
 pub fn cosine_directions(n: DVec3, count: usize, rng: &mut Rng) -> Vec<DVec3> {
-    let (u, v) = frame(n);
-    let side = (count as f64).sqrt().floor().max(1.0) as usize;
-    let mut out = Vec::with_capacity(count);
-    for k in 0..count {
-        let (a, b) = if k < side * side {
-            (((k / side) as f64 + rng.next_f64()) / side as f64, ((k % side) as f64 + rng.next_f64()) / side as f64)
-        } else {
-            (rng.next_f64(), rng.next_f64())
-        };
-        // Malley: uniform on the disc, lifted to the hemisphere.
-        let r = a.sqrt();
-        let phi = 2.0 * std::f64::consts::PI * b;
-        let (x, y) = (r * phi.cos(), r * phi.sin());
-        out.push(u * x + v * y + n * (1.0 - a).max(0.0).sqrt());
+    let axes = frame(n);
+    let side = strata_side(count);
+    (0..count)
+        .map(|k| {
+            let (a, b) = stratified_point(k, side, rng);
+            cosine_direction(n, axes, a, b)
+        })
+        .collect()
+}
+
+/// The side of the grid of strata that [`cosine_directions`] draws `count`
+/// directions on: direction k < side² lies in cell (k / side, k % side).
+pub fn strata_side(count: usize) -> usize {
+    (count as f64).sqrt().floor().max(1.0) as usize
+}
+
+/// `count` cosine-weighted directions about `n` within the stratum
+/// (`i`, `j`) of a `side` × `side` grid of [`cosine_directions`], themselves
+/// stratified: the stratum's part of the hemisphere sampled again, finer.
+pub fn cosine_directions_in(n: DVec3, (i, j): (usize, usize), side: usize, count: usize, rng: &mut Rng) -> Vec<DVec3> {
+    let axes = frame(n);
+    let sub = strata_side(count);
+    (0..count)
+        .map(|k| {
+            let (a, b) = stratified_point(k, sub, rng);
+            cosine_direction(n, axes, (i as f64 + a) / side as f64, (j as f64 + b) / side as f64)
+        })
+        .collect()
+}
+
+/// Point k of the unit square: jittered in cell (k / side, k % side) of a
+/// `side` × `side` grid, at random past its last cell.
+fn stratified_point(k: usize, side: usize, rng: &mut Rng) -> (f64, f64) {
+    if k < side * side {
+        (((k / side) as f64 + rng.next_f64()) / side as f64, ((k % side) as f64 + rng.next_f64()) / side as f64)
+    } else {
+        (rng.next_f64(), rng.next_f64())
     }
-    out
+}
+
+/// The cosine-weighted direction about `n` (with in-plane `axes`) at the
+/// point (a, b) of the unit square. Malley: uniform on the disc, lifted to
+/// the hemisphere.
+fn cosine_direction(n: DVec3, (u, v): (DVec3, DVec3), a: f64, b: f64) -> DVec3 {
+    let r = a.sqrt();
+    let phi = 2.0 * std::f64::consts::PI * b;
+    let (x, y) = (r * phi.cos(), r * phi.sin());
+    u * x + v * y + n * (1.0 - a).max(0.0).sqrt()
 }
 
 /// A uniformly distributed point on a triangle from two uniform numbers.
