@@ -925,25 +925,57 @@ mod tests {
     use crate::panel::PanelCatalog;
     use crate::scene::load_scene;
 
+    /// Appends an OBJ quad of `material`, moved `x0` along x.
+    fn quad(obj: &mut String, material: &str, x0: f64, corners: [[f64; 3]; 4]) {
+        let _ = writeln!(obj, "usemtl {material}");
+        for [x, y, z] in corners {
+            let _ = writeln!(obj, "v {} {y} {z}", x0 + x);
+        }
+        let _ = writeln!(obj, "f -4 -3 -2 -1");
+    }
+
+    /// The faces of a 4 × 4 × 3 m box from `x0`, wound inward, but those
+    /// named in `open` (floor, ceiling, north, west, south, east): OBJ quads.
+    fn box_but(obj: &mut String, x0: f64, open: &[&str]) {
+        let faces = [
+            ("floor", [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 4.0, 0.0], [0.0, 4.0, 0.0]]),
+            ("ceiling", [[0.0, 0.0, 3.0], [0.0, 4.0, 3.0], [4.0, 4.0, 3.0], [4.0, 0.0, 3.0]]),
+            ("north", [[0.0, 4.0, 0.0], [4.0, 4.0, 0.0], [4.0, 4.0, 3.0], [0.0, 4.0, 3.0]]),
+            ("west", [[0.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 4.0, 3.0], [0.0, 0.0, 3.0]]),
+            ("south", [[0.0, 0.0, 0.0], [0.0, 0.0, 3.0], [4.0, 0.0, 3.0], [4.0, 0.0, 0.0]]),
+            ("east", [[4.0, 0.0, 0.0], [4.0, 0.0, 3.0], [4.0, 4.0, 3.0], [4.0, 4.0, 0.0]]),
+        ];
+        for (_, corners) in faces.into_iter().filter(|(name, _)| !open.contains(name)) {
+            quad(obj, "wall", x0, corners);
+        }
+    }
+
     /// A 4 × 4 × 3 m room from `x0`, its faces wound inward, its south wall
     /// glazed from 1 to 3 m across and 1 to 2 m up: OBJ quads.
     fn room(obj: &mut String, x0: f64) {
-        let mut quad = |material: &str, corners: [[f64; 3]; 4]| {
-            let _ = writeln!(obj, "usemtl {material}");
-            for [x, y, z] in corners {
-                let _ = writeln!(obj, "v {} {y} {z}", x0 + x);
-            }
-            let _ = writeln!(obj, "f -4 -3 -2 -1");
-        };
-        quad("wall", [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 4.0, 0.0], [0.0, 4.0, 0.0]]);
-        quad("wall", [[0.0, 0.0, 3.0], [0.0, 4.0, 3.0], [4.0, 4.0, 3.0], [4.0, 0.0, 3.0]]);
-        quad("wall", [[0.0, 4.0, 0.0], [4.0, 4.0, 0.0], [4.0, 4.0, 3.0], [0.0, 4.0, 3.0]]);
-        quad("wall", [[0.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 4.0, 3.0], [0.0, 0.0, 3.0]]);
-        quad("wall", [[4.0, 0.0, 0.0], [4.0, 0.0, 3.0], [4.0, 4.0, 3.0], [4.0, 4.0, 0.0]]);
+        box_but(obj, x0, &["south"]);
         for (xa, xb, za, zb) in [(0.0, 4.0, 0.0, 1.0), (0.0, 4.0, 2.0, 3.0), (0.0, 1.0, 1.0, 2.0), (3.0, 4.0, 1.0, 2.0)] {
-            quad("wall", [[xa, 0.0, za], [xa, 0.0, zb], [xb, 0.0, zb], [xb, 0.0, za]]);
+            quad(obj, "wall", x0, [[xa, 0.0, za], [xa, 0.0, zb], [xb, 0.0, zb], [xb, 0.0, za]]);
         }
-        quad("glass", [[1.0, 0.0, 1.0], [1.0, 0.0, 2.0], [3.0, 0.0, 2.0], [3.0, 0.0, 1.0]]);
+        quad(obj, "glass", x0, [[1.0, 0.0, 1.0], [1.0, 0.0, 2.0], [3.0, 0.0, 2.0], [3.0, 0.0, 1.0]]);
+    }
+
+    /// A sensor facing up, 0.8 m above the middle of the floor of the room
+    /// at the origin.
+    const DESK: &str = "[[sensors]]\nname = \"desk\"\nposition = [2.0, 2.0, 0.8]\nnormal = [0.0, 0.0, 1.0]\n";
+
+    /// The scene of `obj` (grey walls, clear glass) at 45° N, with `more`
+    /// (sensors) appended to its file, loaded from a folder of its own.
+    fn scene_of(name: &str, obj: &str, more: &str) -> Arc<Scene> {
+        let dir = std::env::temp_dir().join(format!("heliodon-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("m.obj"), format!("mtllib m.mtl\n{obj}")).unwrap();
+        std::fs::write(dir.join("m.mtl"), "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.8\n").unwrap();
+        let scene = format!("[site]\nlatitude = 45.0\nlongitude = 0.0\ntimezone = 0.0\n[model]\nobj = \"m.obj\"\n{more}");
+        std::fs::write(dir.join("scene.toml"), scene).unwrap();
+        let scene = Arc::new(load_scene(&dir.join("scene.toml"), &PanelCatalog::new()).unwrap().scene);
+        std::fs::remove_dir_all(&dir).ok();
+        scene
     }
 
     /// A room with a doorway and no window, and beside it a room closed but
@@ -952,33 +984,15 @@ mod tests {
     /// joins the doorway's space), and the second room stays enclosed.
     #[test]
     fn the_sun_through_a_doorway_reaches_the_sides_whose_own_rays_missed_it() {
-        let dir = std::env::temp_dir().join(format!("heliodon-doorway-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let mut obj = String::from("mtllib m.mtl\n");
         // 4 × 4 × 3 m, wound inward; the east wall has a doorway 1 m wide
         // (y 1.5–2.5) and 2 m high.
-        let mut quad = |corners: [[f64; 3]; 4]| {
-            let _ = writeln!(obj, "usemtl wall");
-            for [x, y, z] in corners {
-                let _ = writeln!(obj, "v {x} {y} {z}");
-            }
-            let _ = writeln!(obj, "f -4 -3 -2 -1");
-        };
-        quad([[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 4.0, 0.0], [0.0, 4.0, 0.0]]);
-        quad([[0.0, 0.0, 3.0], [0.0, 4.0, 3.0], [4.0, 4.0, 3.0], [4.0, 0.0, 3.0]]);
-        quad([[0.0, 4.0, 0.0], [4.0, 4.0, 0.0], [4.0, 4.0, 3.0], [0.0, 4.0, 3.0]]);
-        quad([[0.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 4.0, 3.0], [0.0, 0.0, 3.0]]);
-        quad([[0.0, 0.0, 0.0], [0.0, 0.0, 3.0], [4.0, 0.0, 3.0], [4.0, 0.0, 0.0]]);
+        let mut obj = String::new();
+        box_but(&mut obj, 0.0, &["east"]);
         for (ya, yb, za, zb) in [(0.0, 1.5, 0.0, 3.0), (2.5, 4.0, 0.0, 3.0), (1.5, 2.5, 2.0, 3.0)] {
-            quad([[4.0, ya, za], [4.0, ya, zb], [4.0, yb, zb], [4.0, yb, za]]);
+            quad(&mut obj, "wall", 0.0, [[4.0, ya, za], [4.0, ya, zb], [4.0, yb, zb], [4.0, yb, za]]);
         }
         room(&mut obj, -6.0);
-        std::fs::write(dir.join("m.obj"), obj).unwrap();
-        std::fs::write(dir.join("m.mtl"), "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.8\n").unwrap();
-        let scene = "[site]\nlatitude = 45.0\nlongitude = 0.0\ntimezone = 0.0\n[model]\nobj = \"m.obj\"\n";
-        std::fs::write(dir.join("scene.toml"), scene).unwrap();
-        let scene = Arc::new(load_scene(&dir.join("scene.toml"), &PanelCatalog::new()).unwrap().scene);
-        std::fs::remove_dir_all(&dir).ok();
+        let scene = scene_of("doorway", &obj, "");
         // Few rays: a floor side sees the doorway in about one ray of twenty.
         let settings = LightSettings { rays_per_patch: 24, window_rays_per_patch: 8, ..LightSettings::default() };
         let model = LightModel::precompute(scene.clone(), settings).unwrap();
@@ -1012,31 +1026,13 @@ mod tests {
     /// along the hole's outline (4,096 rays alone: up to 1.6% off).
     #[test]
     fn the_open_sky_through_a_hole_fills_its_view_factor_of_the_sensors_view() {
-        let dir = std::env::temp_dir().join(format!("heliodon-hole-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let mut obj = String::from("mtllib m.mtl\nusemtl wall\n");
-        let mut quad = |corners: [[f64; 3]; 4]| {
-            for [x, y, z] in corners {
-                let _ = writeln!(obj, "v {x} {y} {z}");
-            }
-            let _ = writeln!(obj, "f -4 -3 -2 -1");
-        };
-        quad([[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 4.0, 0.0], [0.0, 4.0, 0.0]]);
-        quad([[0.0, 4.0, 0.0], [4.0, 4.0, 0.0], [4.0, 4.0, 3.0], [0.0, 4.0, 3.0]]);
-        quad([[0.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 4.0, 3.0], [0.0, 0.0, 3.0]]);
-        quad([[0.0, 0.0, 0.0], [0.0, 0.0, 3.0], [4.0, 0.0, 3.0], [4.0, 0.0, 0.0]]);
-        quad([[4.0, 0.0, 0.0], [4.0, 0.0, 3.0], [4.0, 4.0, 3.0], [4.0, 4.0, 0.0]]);
+        let mut obj = String::new();
+        box_but(&mut obj, 0.0, &["ceiling"]);
         // The ceiling round the hole (x, y 1.5–2.5).
         for (xa, xb, ya, yb) in [(0.0, 4.0, 0.0, 1.5), (0.0, 4.0, 2.5, 4.0), (0.0, 1.5, 1.5, 2.5), (2.5, 4.0, 1.5, 2.5)] {
-            quad([[xa, ya, 3.0], [xa, yb, 3.0], [xb, yb, 3.0], [xb, ya, 3.0]]);
+            quad(&mut obj, "wall", 0.0, [[xa, ya, 3.0], [xa, yb, 3.0], [xb, yb, 3.0], [xb, ya, 3.0]]);
         }
-        std::fs::write(dir.join("m.obj"), obj).unwrap();
-        std::fs::write(dir.join("m.mtl"), "newmtl wall\nKd 0.5 0.5 0.5\n").unwrap();
-        let scene = "[site]\nlatitude = 45.0\nlongitude = 0.0\ntimezone = 0.0\n[model]\nobj = \"m.obj\"\n\
-                     [[sensors]]\nname = \"desk\"\nposition = [2.0, 2.0, 0.8]\nnormal = [0.0, 0.0, 1.0]\n";
-        std::fs::write(dir.join("scene.toml"), scene).unwrap();
-        let scene = Arc::new(load_scene(&dir.join("scene.toml"), &PanelCatalog::new()).unwrap().scene);
-        std::fs::remove_dir_all(&dir).ok();
+        let scene = scene_of("hole", &obj, DESK);
         // A corner of the hole: sides a and b over the height, in units of it.
         let corner = |a: f64, b: f64| {
             let (p, q) = ((1.0 + a * a).sqrt(), (1.0 + b * b).sqrt());
@@ -1063,18 +1059,10 @@ mod tests {
     /// no more sides than it traced rays.
     #[test]
     fn sides_trace_fewer_rays_the_farther_their_light_is_from_the_sensors() {
-        let dir = std::env::temp_dir().join(format!("heliodon-sight-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let mut obj = String::from("mtllib m.mtl\n");
+        let mut obj = String::new();
         room(&mut obj, 0.0);
         room(&mut obj, 5.0);
-        std::fs::write(dir.join("m.obj"), obj).unwrap();
-        std::fs::write(dir.join("m.mtl"), "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.8\n").unwrap();
-        let scene = "[site]\nlatitude = 45.0\nlongitude = 0.0\ntimezone = 0.0\n[model]\nobj = \"m.obj\"\n\
-                     [[sensors]]\nname = \"desk\"\nposition = [2.0, 2.0, 0.8]\nnormal = [0.0, 0.0, 1.0]\n";
-        std::fs::write(dir.join("scene.toml"), scene).unwrap();
-        let scene = Arc::new(load_scene(&dir.join("scene.toml"), &PanelCatalog::new()).unwrap().scene);
-        std::fs::remove_dir_all(&dir).ok();
+        let scene = scene_of("sight", &obj, DESK);
         let settings = LightSettings { rays_per_patch: 64, window_rays_per_patch: 16, ..LightSettings::default() };
         let model = LightModel::precompute(scene.clone(), settings).unwrap();
         // Each side's steps from the sensors, as the gathers found them.
