@@ -1128,6 +1128,38 @@ fn the_first_view_looks_into_one_room() {
     assert!((moved.eye.x - 4.0).abs() > 0.3 && room(moved.eye.x) == room(moved.target.x), "{} → {}", moved.eye, moved.target);
 }
 
+/// A room with a doorway in its south wall and no glass anywhere (a model
+/// exported without its panes): the first view stands inside the room,
+/// behind its sensors, and looks out at the doorway, not at the roof.
+#[test]
+fn the_first_view_of_a_room_without_glass_looks_at_its_opening() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("open_room");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut obj = quad_obj::QuadObj::new("room.mtl");
+    let (w, d, h) = (6.0, 4.0, 3.0);
+    room_on_ground::room_open_to_south(&mut obj, w, d, h);
+    // The south wall with a doorway 2 m wide and 2.2 m high in its middle.
+    obj.quad("wall", [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 0.0, h], [0.0, 0.0, h]]);
+    obj.quad("wall", [[4.0, 0.0, 0.0], [w, 0.0, 0.0], [w, 0.0, h], [4.0, 0.0, h]]);
+    obj.quad("wall", [[2.0, 0.0, 2.2], [4.0, 0.0, 2.2], [4.0, 0.0, h], [2.0, 0.0, h]]);
+    std::fs::write(dir.join("room.obj"), obj.text()).unwrap();
+    std::fs::write(dir.join("room.mtl"), "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl ceiling\nKd 0.8 0.8 0.8\nnewmtl wall\nKd 0.5 0.5 0.5\n")
+        .unwrap();
+    let scene = "name = \"Open room\"\n[site]\nlatitude = 40.78\nlongitude = -73.97\ntimezone = -5.0\n[model]\nobj = \"room.obj\"\n\n\
+                 [[sensor_grids]]\nname = \"desks\"\nmin = [0.5, 0.5]\nmax = [5.5, 3.5]\nheight = 0.8\nspacing = 1.0\n";
+    std::fs::write(dir.join("scene.toml"), scene).unwrap();
+    let model = LightModel::unlit(load(&dir.join("scene.toml")));
+    let view = model.interior_view().expect("a view from the sensors' room");
+    println!("eye {}, target {}", view.eye, view.target);
+    let inside = |p: glam::Vec3| p.x > 0.0 && p.x < w as f32 && p.y > 0.0 && p.y < d as f32 && p.z > 0.0 && p.z < h as f32;
+    assert!(inside(view.eye), "the eye stands in the room: {}", view.eye);
+    assert!(view.eye.y > 2.5, "at the back of the room: {}", view.eye);
+    // The line of sight passes through the doorway.
+    let way = (view.target - view.eye).normalize();
+    let at_wall = view.eye + way * (view.eye.y / -way.y);
+    assert!(way.y < -0.9 && (2.0..4.0).contains(&at_wall.x) && (0.0..2.2).contains(&at_wall.z), "{} → {}", view.eye, view.target);
+}
+
 /// A panel as a modder would write one, for the lobe coefficients' test: a
 /// third of the sun straight through, half turned up toward the ceiling
 /// (mirrored in the panel's vertical) in a 6° cone.

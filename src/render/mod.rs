@@ -400,9 +400,9 @@ fn hidden(
 }
 
 /// The view a scene opens on: its first `[[cameras]]` entry, else a view
-/// from inside the room behind its largest windows looking out through them
-/// (`model` traces where the room's far wall and floor are), else the
-/// [`overview`].
+/// from inside the room behind its largest windows looking out through them,
+/// or with no window from the sensors' room toward its opening (`model`
+/// traces where the room's walls and floor are), else the [`overview`].
 pub fn initial_view(scene: &Scene, model: Option<&LightModel>) -> Viewpoint {
     if let Some(first) = scene.viewpoints.first() {
         return first.clone();

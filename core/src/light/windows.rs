@@ -92,6 +92,9 @@ const VIEW_SENSOR_STOREY: f32 = 2.0;
 const FRAME_DEPTH: f32 = 0.5;
 /// Eye height above the floor for an automatic view, m.
 const EYE_HEIGHT: f32 = 1.5;
+/// Horizontal ways tried for where a windowless room opens, for the
+/// automatic view.
+const OPENING_WAYS: usize = 32;
 /// Windows of a group closer than this (m, centre to centre) light one
 /// room, for the automatic view.
 const WINDOW_CLUSTER: f32 = 2.5;
@@ -130,8 +133,9 @@ impl super::LightModel {
     /// floor's sun patches and the windows are both in view. Where
     /// something stands between that corner and the windows (a stair, a
     /// column), the other back corner, then places nearer the windows, are
-    /// tried for a clear sight. `None` without vertical windows that see
-    /// the sky.
+    /// tried for a clear sight. Without vertical windows that see the sky,
+    /// the view from the sensors' room toward where it opens
+    /// ([`Self::view_toward_the_opening`]); `None` without either.
     pub fn interior_view(&self) -> Option<crate::scene::Viewpoint> {
         let scene = &self.scene;
         let centroids = |cluster: &[u32]| cluster.iter().map(|&w| scene.windows[w as usize].centroid).collect::<Vec<_>>();
@@ -154,7 +158,7 @@ impl super::LightModel {
             })
             .max_by(|(a, ..), (b, ..)| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)))
             .map(|(_, g, c)| (g, c));
-        let (group, cluster) = cluster?;
+        let Some((group, cluster)) = cluster else { return self.view_toward_the_opening() };
         let middle = cluster.iter().map(|&w| scene.windows[w as usize].centroid * scene.windows[w as usize].area).sum::<glam::Vec3>()
             / area(&cluster);
         // The window nearest the sensors where these windows light them all
@@ -200,6 +204,48 @@ impl super::LightModel {
         } else {
             places[1..].iter().map(|&(back, side)| place(back, side)).find(sees_windows).unwrap_or(first)
         };
+        Some(crate::scene::Viewpoint { name: "inside".into(), eye, target, fov: crate::scene::DEFAULT_FOV })
+    }
+
+    /// A view from inside the sensors' room where no window lights it (a
+    /// model exported without its glass, a room open to the outside): from
+    /// the sensors' middle at eye height, toward the middle of the widest
+    /// run of horizontal ways that leave the model (through the opening),
+    /// else the way that reaches farthest; the eye steps back toward the
+    /// wall behind, so the floor and the opening are both in view. `None`
+    /// without sensors, or where every way leaves (sensors outdoors).
+    fn view_toward_the_opening(&self) -> Option<crate::scene::Viewpoint> {
+        let sensors = &self.scene.sensors;
+        if sensors.is_empty() {
+            return None;
+        }
+        let middle = sensors.iter().map(|s| s.position).sum::<glam::Vec3>() / sensors.len() as f32;
+        let reach = |from: glam::Vec3, direction: glam::Vec3, fallback: f32| {
+            self.trace(from.as_dvec3(), direction.as_dvec3()).map_or(fallback, |(_, d)| d as f32)
+        };
+        let floor = middle.z - reach(middle, glam::Vec3::NEG_Z, 0.0);
+        let from = glam::Vec3::new(middle.x, middle.y, floor + EYE_HEIGHT);
+        let ways: Vec<(glam::Vec3, f32)> = (0..OPENING_WAYS)
+            .map(|k| {
+                let (sin, cos) = (k as f32 * std::f32::consts::TAU / OPENING_WAYS as f32).sin_cos();
+                let way = glam::Vec3::new(cos, sin, 0.0);
+                (way, reach(from, way, f32::INFINITY))
+            })
+            .collect();
+        let leaves = |k: usize| ways[k % OPENING_WAYS].1.is_infinite();
+        // Each run of ways that leave, from its first way: its length and middle.
+        let runs = (0..OPENING_WAYS).filter(|&k| leaves(k) && !leaves(k + OPENING_WAYS - 1)).map(|first| {
+            let length = (0..OPENING_WAYS).take_while(|&j| leaves(first + j)).count();
+            (length, (first + length / 2) % OPENING_WAYS)
+        });
+        let best = match runs.max_by_key(|&(length, _)| length) {
+            Some((_, middle)) => middle,
+            None if leaves(0) => return None,
+            None => (0..OPENING_WAYS).max_by(|&a, &b| ways[a].1.total_cmp(&ways[b].1))?,
+        };
+        let (way, ahead) = ways[best];
+        let eye = from - way * (0.8 * reach(from, -way, 2.0));
+        let target = from + way * ahead.min(3.0) + glam::Vec3::Z * (1.0 - EYE_HEIGHT);
         Some(crate::scene::Viewpoint { name: "inside".into(), eye, target, fov: crate::scene::DEFAULT_FOV })
     }
 
