@@ -298,6 +298,21 @@ fn unused_scene_material_is_a_warning() {
     assert!(w.message.contains("no face of") && w.message.contains("'marble'"), "{w}");
 }
 
+/// A model with sensors and no surface that passes light (panes left out
+/// by the export, or glass whose material reads as opaque) says so once;
+/// with a pane it says nothing of it.
+#[test]
+fn sensors_in_a_model_without_glass_are_a_warning() {
+    let sensor = "\n[[sensors]]\nname = \"desk\"\nposition = [0.5, 0.5, 0.8]\nnormal = [0.0, 0.0, 1.0]\n";
+    let without_glass = fixture("no_glass", &scene_toml(sensor), &OBJ.replace("usemtl glass\n", ""));
+    let loaded = without_glass.load().unwrap();
+    let said: Vec<_> = loaded.warnings.iter().filter(|w| w.message.starts_with("no surface passes light")).collect();
+    assert_eq!(said.len(), 1, "{:?}", loaded.warnings);
+    assert!(said[0].location.file.ends_with("room.obj") && said[0].message.contains("kind = \"glass\""), "{}", said[0]);
+    let with_glass = fixture("with_glass", &scene_toml(sensor), OBJ).load().unwrap();
+    assert!(with_glass.warnings.iter().all(|w| !w.message.starts_with("no surface passes light")), "{:?}", with_glass.warnings);
+}
+
 #[test]
 fn unregistered_panel() {
     let toml = scene_toml("\n[materials.glass]\nkind = \"panel\"\npanel = \"prismatic\"\nfacet_angles = [40.0, 5.0]\n");

@@ -352,6 +352,12 @@ fn build(
     }
     let windows = surfaces::windows(&triangles, &surfaces, &materials);
     let sensors = sensors::sensors(parsed)?;
+    if windows.is_empty() && !sensors.is_empty() {
+        warnings.push(SceneWarning {
+            location: Location::file(obj_path),
+            message: "no surface passes light (no glass or panel material): daylight comes in through open air only; if the model's panes are there, give their material kind = \"glass\" under [materials], and if the export left them out, the rooms read too bright".into(),
+        });
+    }
     let (sizing, _) = sizing_and_focus(parsed, &sensors, &triangles, &surfaces, &windows);
     // Clutter gathers into clusters; windows keep patches of their own.
     let clusterable: Vec<bool> =
