@@ -59,10 +59,11 @@ const SEEN_PROBE_RAYS: usize = 256;
 /// rays, at most [`LITTLE_UNAIMED_SKY`] of them) traces this many sets of
 /// its hemisphere rays for the sky and form factors: the sky through an
 /// opening no window fills (or a window not aimed at) comes by them alone,
-/// and deep in a room it is a few of them. (bim2sim's 3 rooms, an L-shaped room open to the
-/// outside, overcast: readings' spread over seeds 1.7 → 1.4% with the
-/// edges retraced, against rtrace median 1.85 → 1.23%, p90 5.7 → 3.7%;
-/// cold `sensors` 1.0 → 1.8 s. Rooms lit through glass keep 1 set.)
+/// and deep in a room it is a few of them. (bim2sim's 3 rooms, an L-shaped
+/// room open to the outside, overcast: readings' spread over seeds 1.7 →
+/// 1.4% with the edges retraced, against rtrace median 1.85 → 1.23%, p90
+/// 5.7 → 3.7%; cold `sensors` 1.0 → 1.8 s. Rooms lit through glass keep
+/// 1 set.)
 const UNAIMED_SKY_SETS: usize = 4;
 /// Of a sensor's [`SEEN_PROBE_RAYS`], the most that may reach the sky no
 /// aimed ray draws for it to see a little of it: a sensor seeing much of it
