@@ -809,8 +809,9 @@ impl LightModel {
     /// strata on the edge of the sky a receiver's hemisphere rays keep
     /// (those whose neighbours' rays disagree on reaching it: the
     /// outline of an opening no window fills, a skyline), their one ray's
-    /// part dropped. Unbiased, as the rays that replace a stratum's are
-    /// new; the edges are where the sky's share of the rays is noisy.
+    /// part dropped. Unbiased, as which strata are traced again does not
+    /// hang on their own rays and the rays that replace them are new; the
+    /// edges are where the sky's share of the rays is noisy.
     fn retrace_sky_edges(
         &self,
         strata: &[StratumRay],
@@ -820,21 +821,21 @@ impl LightModel {
         coefficients: &mut Vec<(u32, f64)>,
         hits: &mut Vec<SideHit>,
     ) {
-        let on_edge: Vec<bool> = strata.iter().map(|ray| ray.is_on_sky_edge(strata)).collect();
-        if !on_edge.contains(&true) {
+        let edges: Vec<&StratumRay> = strata.iter().filter(|ray| ray.is_on_sky_edge(strata)).collect();
+        if edges.is_empty() {
             return;
         }
         let (mut dropped_coefficients, mut dropped_hits) = (vec![false; coefficients.len()], vec![false; hits.len()]);
-        for ray in strata.iter().zip(&on_edge).filter(|e| *e.1).map(|e| e.0) {
+        for ray in &edges {
             dropped_coefficients[ray.coefficients.clone()].fill(true);
             dropped_hits[ray.hits.clone()].fill(true);
         }
-        let mut k = 0;
-        coefficients.retain(|_| (!dropped_coefficients[k], k += 1).0);
-        k = 0;
-        hits.retain(|_| (!dropped_hits[k], k += 1).0);
+        let mut dropped = dropped_coefficients.into_iter();
+        coefficients.retain(|_| !dropped.next().unwrap_or(false));
+        let mut dropped = dropped_hits.into_iter();
+        hits.retain(|_| !dropped.next().unwrap_or(false));
         let weight = 1.0 / SKY_EDGE_RAYS as f64;
-        for ray in strata.iter().zip(&on_edge).filter(|e| *e.1).map(|e| e.0) {
+        for ray in edges {
             let cell = ray.cell.expect("only strata of the grid are on an edge");
             for dir in sampling::cosine_directions_in(normal, cell, ray.side, SKY_EDGE_RAYS, rng) {
                 self.follow(ray.point, dir, weight, 0, Way::START, keep_sky, coefficients, hits);

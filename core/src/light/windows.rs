@@ -172,29 +172,25 @@ impl super::LightModel {
         let centre = windows.iter().copied().min_by(nearest(sensor.unwrap_or(middle)))?;
         let inward = -glam::Vec3::new(group.outward.x as f32, group.outward.y as f32, 0.0).normalize();
         let across = inward.cross(glam::Vec3::Z);
-        // How far a ray goes from `from` along `direction` before a surface (`fallback` if none).
-        let reach = |from: glam::Vec3, direction: glam::Vec3, fallback: f32| {
-            self.trace(from.as_dvec3(), direction.as_dvec3()).map_or(fallback, |(_, d)| d as f32)
-        };
         // The room's depth, past the window's own frame and sill.
         let mut depth = 0.05;
         while depth < FRAME_DEPTH {
-            depth += 1e-3 + reach(centre + inward * depth, inward, 5.0);
+            depth += 1e-3 + self.reach(centre + inward * depth, inward, 5.0);
         }
         // The eye `back` of the room's depth in from the windows, toward the
         // side wall along `side`; and the target it looks at.
         let place = |back: f32, side: glam::Vec3| {
             let mut eye = centre + inward * (back * depth);
             if side != glam::Vec3::ZERO {
-                eye += side * (0.6 * reach(eye, side, 2.0));
+                eye += side * (0.6 * self.reach(eye, side, 2.0));
             }
-            let floor = eye.z - reach(eye, glam::Vec3::NEG_Z, EYE_HEIGHT);
+            let floor = eye.z - self.reach(eye, glam::Vec3::NEG_Z, EYE_HEIGHT);
             eye.z = floor + EYE_HEIGHT;
             (eye, glam::Vec3::new(centre.x, centre.y, floor + 1.0))
         };
         // Nothing (a stair, a column, a wardrobe) between the eye and the windows.
         let sees_windows = |(eye, target): &(glam::Vec3, glam::Vec3)| {
-            reach(*eye, (*target - *eye).normalize_or_zero(), f32::INFINITY) >= 0.9 * eye.distance(*target)
+            self.reach(*eye, (*target - *eye).normalize_or_zero(), f32::INFINITY) >= 0.9 * eye.distance(*target)
         };
         // The back corner, then the other back corner, then nearer the windows.
         let places = [(0.85, across), (0.85, -across), (0.6, across), (0.6, -across), (0.4, glam::Vec3::ZERO)];
@@ -220,16 +216,13 @@ impl super::LightModel {
             return None;
         }
         let middle = sensors.iter().map(|s| s.position).sum::<glam::Vec3>() / sensors.len() as f32;
-        let reach = |from: glam::Vec3, direction: glam::Vec3, fallback: f32| {
-            self.trace(from.as_dvec3(), direction.as_dvec3()).map_or(fallback, |(_, d)| d as f32)
-        };
-        let floor = middle.z - reach(middle, glam::Vec3::NEG_Z, 0.0);
+        let floor = middle.z - self.reach(middle, glam::Vec3::NEG_Z, 0.0);
         let from = glam::Vec3::new(middle.x, middle.y, floor + EYE_HEIGHT);
         let ways: Vec<(glam::Vec3, f32)> = (0..OPENING_WAYS)
             .map(|k| {
                 let (sin, cos) = (k as f32 * std::f32::consts::TAU / OPENING_WAYS as f32).sin_cos();
                 let way = glam::Vec3::new(cos, sin, 0.0);
-                (way, reach(from, way, f32::INFINITY))
+                (way, self.reach(from, way, f32::INFINITY))
             })
             .collect();
         let leaves = |k: usize| ways[k % OPENING_WAYS].1.is_infinite();
@@ -244,9 +237,15 @@ impl super::LightModel {
             None => (0..OPENING_WAYS).max_by(|&a, &b| ways[a].1.total_cmp(&ways[b].1))?,
         };
         let (way, ahead) = ways[best];
-        let eye = from - way * (0.8 * reach(from, -way, 2.0));
+        let eye = from - way * (0.8 * self.reach(from, -way, 2.0));
         let target = from + way * ahead.min(3.0) + glam::Vec3::Z * (1.0 - EYE_HEIGHT);
         Some(crate::scene::Viewpoint { name: "inside".into(), eye, target, fov: crate::scene::DEFAULT_FOV })
+    }
+
+    /// How far a ray goes from `from` along `direction` before a surface
+    /// (`fallback` if none): what the automatic views measure rooms by.
+    fn reach(&self, from: glam::Vec3, direction: glam::Vec3, fallback: f32) -> f32 {
+        self.trace(from.as_dvec3(), direction.as_dvec3()).map_or(fallback, |(_, d)| d as f32)
     }
 
     /// The height of a plan's horizontal section for a camera at `eye`:
