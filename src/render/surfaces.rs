@@ -401,11 +401,19 @@ impl MeshBuilder {
     }
 }
 
+/// Two surfaces whose normals meet at a corner within this angle's cosine
+/// (30°) are one curved sheet there: a hill or a round column tessellated
+/// into facets, whose corners show the mean of the facets that meet.
+const SMOOTH_CREASE_COS: f32 = 0.866;
+
 /// Both sides of every patch of `material` (the back side wound the other
-/// way), with vertex nodes shared within one surface and side.
+/// way), with vertex nodes shared within one surface and side; a node also
+/// averages the other surfaces' sides meeting at its corner within
+/// [`SMOOTH_CREASE_COS`] ([`smooth_shallow_creases`]).
 fn material_mesh(scene: &Scene, material: u32) -> Option<(Mesh, SurfaceValues)> {
     let mut builder = MeshBuilder::default();
     let mut node_of: HashMap<(u32, bool, [i64; 3]), u32> = HashMap::new();
+    let mut node_normals: Vec<Vec3> = Vec::new();
     for (p, patch) in scene.patches.patches.iter().enumerate().filter(|(_, p)| p.material == material) {
         let triangles = &scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize];
         for back in [false, true] {
@@ -420,6 +428,7 @@ fn material_mesh(scene: &Scene, material: u32) -> Option<(Mesh, SurfaceValues)> 
                     let node = *node_of.entry(key).or_insert(nodes.len() as u32);
                     if node as usize == nodes.len() {
                         nodes.push(Vec::new());
+                        node_normals.push(normal);
                     }
                     nodes[node as usize].push((side, area));
                     node
@@ -428,7 +437,30 @@ fn material_mesh(scene: &Scene, material: u32) -> Option<(Mesh, SurfaceValues)> 
             }
         }
     }
+    let mut corners: Vec<([i64; 3], u32)> = node_of.into_iter().map(|((_, _, corner), node)| (corner, node)).collect();
+    corners.sort_unstable();
+    smooth_shallow_creases(&mut builder.values.nodes, &corners, &node_normals);
     (!builder.positions.is_empty()).then(|| builder.build())
+}
+
+/// Adds to each node the patch sides of the other nodes at its corner
+/// (`corners`: (corner, node), sorted) whose normal is within
+/// [`SMOOTH_CREASE_COS`] of its own: the facets of a curved sheet (a
+/// terrain, a cylinder, whose clutter also falls into clusters by the main
+/// direction of their normals) then shade smoothly into each other, where
+/// each facet alone showed its own patch's light as a blotch. Walls
+/// meeting a floor, a roof's two slopes, a surface's two sides stay apart.
+fn smooth_shallow_creases(nodes: &mut [Vec<(u32, f32)>], corners: &[([i64; 3], u32)], normals: &[Vec3]) {
+    for meeting in corners.chunk_by(|a, b| a.0 == b.0).filter(|m| m.len() > 1) {
+        let own: Vec<Vec<(u32, f32)>> = meeting.iter().map(|&(_, node)| nodes[node as usize].clone()).collect();
+        for &(_, node) in meeting {
+            for (&(_, other), sides) in meeting.iter().zip(&own) {
+                if other != node && normals[node as usize].dot(normals[other as usize]) >= SMOOTH_CREASE_COS {
+                    nodes[node as usize].extend_from_slice(sides);
+                }
+            }
+        }
+    }
 }
 
 /// What a patch side shows in a mode: luminance (cd/m², RGB) or, for false
@@ -500,5 +532,34 @@ fn update_surface_values(
         if let Some(mut mesh) = meshes.get_mut(&mesh.0) {
             mesh.insert_attribute(Mesh::ATTRIBUTE_COLOR, colours);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Facets of a curved sheet share their light at a corner; a wall on a
+    /// floor, or a surface's other side, does not.
+    #[test]
+    fn corners_average_facets_meeting_at_a_shallow_crease_only() {
+        let tilted = |degrees: f32| Vec3::new(degrees.to_radians().sin(), 0.0, degrees.to_radians().cos());
+        // Node: a facet, the next facet of a hill 20° on, a wall (90°), the first facet's back,
+        // and the first facet again at another corner.
+        let normals = [Vec3::Z, tilted(20.0), Vec3::X, -Vec3::Z, Vec3::Z];
+        let mut nodes: Vec<Vec<(u32, f32)>> = vec![vec![(0, 1.0)], vec![(2, 0.5)], vec![(4, 2.0)], vec![(1, 1.0)], vec![(0, 1.0)]];
+        let corner = [0, 0, 0];
+        let mut corners = vec![(corner, 0), (corner, 1), (corner, 2), (corner, 3), ([1, 0, 0], 4)];
+        corners.sort_unstable();
+        smooth_shallow_creases(&mut nodes, &corners, &normals);
+        assert_eq!(nodes[0], vec![(0, 1.0), (2, 0.5)]);
+        assert_eq!(nodes[1], vec![(2, 0.5), (0, 1.0)]);
+        assert_eq!(nodes[2], vec![(4, 2.0)]);
+        assert_eq!(nodes[3], vec![(1, 1.0)]);
+        assert_eq!(nodes[4], vec![(0, 1.0)]);
+        // Past the crease angle, facets keep their own light.
+        let mut apart: Vec<Vec<(u32, f32)>> = vec![vec![(0, 1.0)], vec![(2, 1.0)]];
+        smooth_shallow_creases(&mut apart, &[(corner, 0), (corner, 1)], &[Vec3::Z, tilted(35.0)]);
+        assert_eq!(apart, vec![vec![(0, 1.0)], vec![(2, 1.0)]]);
     }
 }
