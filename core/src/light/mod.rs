@@ -77,8 +77,11 @@ use sampling::{Rng, cosine_directions};
 
 /// Offset of ray origins off their surface, metres.
 const SURFACE_OFFSET: f64 = 1e-4;
-/// Glass interactions followed along one ray.
-const MAX_GLASS_DEPTH: u32 = 4;
+/// Glass interactions followed along one ray: deep enough for a stack of
+/// panes (a double-skin façade of double glazing; IfcOpenHouse's panes in
+/// glazed linings). At 4 a room behind five panes read 15.8 lx where
+/// Radiance, which follows a ray 32 deep, reads 237.1.
+const MAX_GLASS_DEPTH: u32 = 16;
 /// Branches carrying less than this share of a ray are dropped.
 const MIN_WEIGHT: f64 = 1e-4;
 
