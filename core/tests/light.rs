@@ -599,25 +599,59 @@ fn add_to_room(path: &Path, quads: &quad_obj::QuadObj) {
     std::fs::write(path.with_file_name("room.obj"), obj).unwrap();
 }
 
-/// A window under an opaque face in its own plane (an IFC zone exported as
-/// a box over the façade) is named in one warning; a face in that plane
-/// beside the window, or none, says nothing.
+/// Glass on a face of a solid in that face's plane (a window lining's
+/// glazed face on the wall's reveal, a zone box over the façade) leads into
+/// the solid: it is read as the face, as Radiance and the sun's shadow rays
+/// read it, and named in one warning; the room behind it is dark (the sky
+/// came through it before, the sun did not). Glass under a face of a mere
+/// sheet (a pane pasted on a wall modelled as one face) stays a window and
+/// is named; a face in that plane beside the window says nothing.
 #[test]
-fn a_window_under_an_opaque_face_in_its_plane_is_named() {
-    let warnings = |name: &str, x: [f64; 2]| {
+fn glass_on_a_solid_in_its_plane_is_the_solid() {
+    let load_with = |name: &str, covering: &dyn Fn(&mut quad_obj::QuadObj)| {
         let path = on_a_ground(name, 10.0, 10.0, true);
         let mut quads = quad_obj::QuadObj::new("room.mtl");
-        // In the window's plane (y = 0, the pane at x 1-3, z 0.9-2.3), facing out.
-        quads.quad("wall", [[x[0], 0.0, 0.5], [x[0], 0.0, 2.8], [x[1], 0.0, 2.8], [x[1], 0.0, 0.5]]);
+        covering(&mut quads);
         add_to_room(&path, &quads);
-        load_scene(&path, &PanelCatalog::new()).unwrap().warnings
+        load_scene(&path, &PanelCatalog::new()).unwrap()
     };
-    let over = warnings("covered_window", [0.5, 3.5]);
-    assert_eq!(over.len(), 1, "{over:?}");
-    assert!(over[0].message.starts_with("1 windows lie under an opaque face in their own plane"), "{}", over[0]);
-    assert!(over[0].message.contains("100% covered"), "{}", over[0]);
-    let beside = warnings("window_beside_a_face", [3.2, 4.5]);
-    assert!(beside.is_empty(), "{beside:?}");
+    // The window's plane is y = 0, its pane at x 1-3, z 0.9-2.3; the room lies at y > 0.
+    let (a, b, e, f) = (0.5, 3.5, 0.5, 2.8);
+    let sheet = |x: [f64; 2]| {
+        move |quads: &mut quad_obj::QuadObj| quads.quad("wall", [[x[0], 0.0, e], [x[0], 0.0, f], [x[1], 0.0, f], [x[1], 0.0, e]])
+    };
+    // A block in front of the façade, wound outward, its back face on the pane.
+    let block = |quads: &mut quad_obj::QuadObj| {
+        let (c, d) = (-0.3, 0.0);
+        quads.quad("wall", [[a, c, e], [b, c, e], [b, c, f], [a, c, f]]);
+        quads.quad("wall", [[a, d, e], [a, d, f], [b, d, f], [b, d, e]]);
+        quads.quad("wall", [[a, c, e], [a, c, f], [a, d, f], [a, d, e]]);
+        quads.quad("wall", [[b, c, e], [b, d, e], [b, d, f], [b, c, f]]);
+        quads.quad("wall", [[a, c, e], [a, d, e], [b, d, e], [b, c, e]]);
+        quads.quad("wall", [[a, c, f], [b, c, f], [b, d, f], [a, d, f]]);
+    };
+    let on_solid = load_with("window_on_a_solid", &block);
+    let messages: Vec<&str> = on_solid.warnings.iter().map(|w| w.message.as_str()).collect();
+    assert_eq!(messages.len(), 2, "{messages:?}");
+    assert!(messages[0].starts_with("2 glass triangles of 1 windows lie on the face of a solid in its plane"), "{}", messages[0]);
+    assert!(messages[1].starts_with("no surface passes light"), "{}", messages[1]);
+    assert!(on_solid.scene.windows.is_empty());
+    let scene = Arc::new(on_solid.scene);
+    let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
+    let light = model.solve(&sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "12:00"), None).sensors.iter().map(|r| r.total).sum::<f64>();
+    assert!(light < 1.0, "the room behind the blocked window reads {light} lx in all");
+
+    let under_a_sheet = load_with("window_under_a_sheet", &sheet([a, b]));
+    assert_eq!(under_a_sheet.warnings.len(), 1, "{:?}", under_a_sheet.warnings);
+    assert!(
+        under_a_sheet.warnings[0].message.starts_with("1 windows lie under an opaque face in their own plane"),
+        "{}",
+        under_a_sheet.warnings[0]
+    );
+    assert!(under_a_sheet.warnings[0].message.contains("100% covered"), "{}", under_a_sheet.warnings[0]);
+    assert_eq!(under_a_sheet.scene.windows.len(), 1);
+    let beside = load_with("window_beside_a_face", &sheet([3.2, 4.5]));
+    assert!(beside.warnings.is_empty(), "{:?}", beside.warnings);
 }
 
 /// A pane modelled as a glass box 2 cm thick (as BIM exports write them)

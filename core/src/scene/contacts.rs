@@ -11,8 +11,8 @@
 //! The same large faces keep clutter apart ([`LargeFaces::separating`]):
 //! small parts on the two sides of a door leaf or a wall (a door's handles
 //! outside and in) see different light, so they never share a cluster. And
-//! they find windows that an opaque face covers in their own plane
-//! ([`LargeFaces::covered_share`]), which the loader names.
+//! they find glass that an opaque face covers in their own plane
+//! ([`LargeFaces::covered_quarters`]), which the loader reads as that face.
 
 use std::collections::HashMap;
 
@@ -92,11 +92,12 @@ impl<'a> LargeFaces<'a> {
         planes
     }
 
-    /// The share (0-1) of `surface`'s area that large faces in its own
-    /// plane lie over, counting faces of the materials `opaque` accepts: a
-    /// window under a zone box an export drew over the façade, which one
-    /// ray tracer sees and another does not.
-    pub fn covered_share(&self, surface: &Surface, opaque: impl Fn(u32) -> bool) -> f32 {
+    /// Per triangle of `surface`, how many of its quarters (0-4, a point
+    /// standing for each) large faces in its own plane lie over, counting
+    /// the model's triangles that `counts` accepts (by index): glass under a
+    /// zone box an export drew over the façade, or the glazed face of a
+    /// window's lining lying on the wall's reveal.
+    pub fn covered_quarters(&self, surface: &Surface, counts: impl Fn(usize) -> bool) -> Vec<u8> {
         let own = surface.triangles.start as usize..surface.triangles.end as usize;
         let tris = &self.triangles[own.clone()];
         let (lo, hi) = bounds(tris);
@@ -105,26 +106,28 @@ impl<'a> LargeFaces<'a> {
             .grid
             .near(lo - Vec3::splat(IN_PLANE), hi + Vec3::splat(IN_PLANE))
             .into_iter()
-            .filter(|&t| !own.contains(&(t as usize)))
+            .filter(|&t| !own.contains(&(t as usize)) && counts(t as usize))
             .map(|t| self.triangles[t as usize])
-            .filter(|f| opaque(f.material) && f.normal().dot(normal).abs() > 0.9999)
+            .filter(|f| f.normal().dot(normal).abs() > 0.9999)
             .filter(|f| f.vertices.iter().all(|&v| (normal.dot(v) - offset).abs() <= IN_PLANE))
             .collect();
         if over.is_empty() {
-            return 0.0;
+            return vec![0; tris.len()];
         }
         let flat = Flat::new(normal, &over);
-        // Four points per triangle, each standing for a quarter of its area.
         const POINTS: [[f32; 3]; 4] =
             [[1.0 / 3.0; 3], [2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0], [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0]];
-        let covered: f32 = tris
-            .iter()
-            .map(|t| {
-                let inside =
-                    POINTS.iter().filter(|w| flat.holds(t.vertices[0] * w[0] + t.vertices[1] * w[1] + t.vertices[2] * w[2])).count();
-                t.area() * inside as f32 / 4.0
-            })
-            .sum();
+        tris.iter()
+            .map(|t| POINTS.iter().filter(|w| flat.holds(t.vertices[0] * w[0] + t.vertices[1] * w[1] + t.vertices[2] * w[2])).count() as u8)
+            .collect()
+    }
+
+    /// The share (0-1) of `surface`'s area under opaque faces in its own
+    /// plane ([`Self::covered_quarters`]).
+    pub fn covered_share(&self, surface: &Surface, opaque: impl Fn(u32) -> bool) -> f32 {
+        let tris = &self.triangles[surface.triangles.start as usize..surface.triangles.end as usize];
+        let quarters = self.covered_quarters(surface, |t| opaque(self.triangles[t].material));
+        let covered: f32 = tris.iter().zip(quarters).map(|(t, q)| t.area() * f32::from(q) / 4.0).sum();
         covered / surface.area.max(f32::MIN_POSITIVE)
     }
 }

@@ -350,7 +350,29 @@ fn build(
             .collect();
         (triangles, surfaces) = surfaces::group(keep);
     }
-    let windows = surfaces::windows(&triangles, &surfaces, &materials);
+    let opaque = |material: u32| !materials[material as usize].kind.transmits();
+    let clutter = patches::CLUTTER * parsed.patch_size * parsed.patch_size;
+    let mut large = contacts::LargeFaces::new(&triangles, &surfaces, clutter);
+    let mut windows = surfaces::windows(&triangles, &surfaces, &materials);
+    // Glass lying on a solid's face in its own plane leads into the solid.
+    let buried = repair::glass_on_solids(&large, &triangles, &surfaces, &windows, opaque);
+    if let Some(&(first, _)) = buried.first() {
+        let panes = buried.chunk_by(|a, b| a.0 == b.0).count();
+        warnings.push(SceneWarning {
+            location: Location::file(obj_path),
+            message: format!(
+                "{} glass triangles of {panes} windows lie on the face of a solid in its plane (the first of material '{}'): read as that face, as Radiance and the sun's shadows read it, so no light passes there; if the solid should not be there (an IFC zone exported as geometry over the façade), remove it",
+                buried.len(),
+                materials[windows[first].material as usize].name
+            ),
+        });
+        let mut gone = vec![false; triangles.len()];
+        buried.iter().for_each(|&(_, t)| gone[t as usize] = true);
+        let keep: Vec<Triangle> = triangles.iter().zip(&gone).filter(|(_, gone)| !**gone).map(|(t, _)| *t).collect();
+        (triangles, surfaces) = surfaces::group(keep);
+        windows = surfaces::windows(&triangles, &surfaces, &materials);
+        large = contacts::LargeFaces::new(&triangles, &surfaces, clutter);
+    }
     let sensors = sensors::sensors(parsed)?;
     if windows.is_empty() && !sensors.is_empty() {
         warnings.push(SceneWarning {
@@ -389,10 +411,9 @@ fn build(
             CutPlane::around_window(w.normal, &triangles[range.start as usize..range.end as usize])
         })
         .collect();
-    let large = contacts::LargeFaces::new(&triangles, &surfaces, patches::CLUTTER * parsed.patch_size * parsed.patch_size);
     let covered: Vec<(usize, f32)> = windows
         .iter()
-        .map(|w| large.covered_share(&surfaces[w.surface as usize], |m| !materials[m as usize].kind.transmits()))
+        .map(|w| large.covered_share(&surfaces[w.surface as usize], opaque))
         .enumerate()
         .filter(|&(_, share)| share >= 0.5)
         .collect();

@@ -9,13 +9,23 @@
 //!   the face that sees more of the outside is kept (either works: the
 //!   windows' outward side is ray-tested later), the other and the glass
 //!   edges between them are dropped.
+//! - **Glass on a solid.** Glass lying on a face of a solid in that face's
+//!   plane (a window lining's glazed face on the wall's reveal, as
+//!   IfcOpenHouse models its windows; a zone box over a façade) leads into
+//!   the solid: no window is there. Radiance reads the opaque face, and so
+//!   do the sun's shadow rays; the gathers' rays would cross the glass into
+//!   the solid's dark inside. Such glass is dropped ([`glass_on_solids`]).
+//!   A pane pasted on a wall modelled as one sheet, or on a closed room
+//!   modelled from within, leads outside and stays a window.
 
 use std::collections::HashMap;
 
 use glam::Vec3;
 
+use super::contacts::LargeFaces;
 use super::material::Material;
-use super::{Surface, Triangle};
+use super::shells::model_shells;
+use super::{Surface, Triangle, Window};
 
 /// Glass faces closer than this (m) are the two sides of one pane.
 pub const MAX_PANE_THICKNESS: f32 = 0.06;
@@ -95,4 +105,41 @@ pub fn thick_glass(triangles: &[Triangle], surfaces: &[Surface], materials: &[Ma
         }
     }
     ((0..surfaces.len() as u32).filter(|&s| dropped[s as usize]).collect(), panes.len())
+}
+
+/// The glass triangles of `windows` lying wholly on faces of solids in
+/// their own plane: (window, triangle index). A face of a solid is an
+/// `opaque` triangle of a closed shell wound as the model wrote it,
+/// outward, so what lies behind it is the solid ([`super::shells`]); the
+/// shells are found only when some glass lies on an opaque face at all.
+pub(crate) fn glass_on_solids(
+    large: &LargeFaces,
+    triangles: &[Triangle],
+    surfaces: &[Surface],
+    windows: &[Window],
+    opaque: impl Fn(u32) -> bool,
+) -> Vec<(usize, u32)> {
+    let covered_by = |counts: &dyn Fn(usize) -> bool| -> Vec<(usize, u32)> {
+        windows
+            .iter()
+            .enumerate()
+            .flat_map(|(k, window)| {
+                let surface = &surfaces[window.surface as usize];
+                let quarters = large.covered_quarters(surface, counts);
+                surface.triangles.clone().zip(quarters).filter(|&(_, q)| q == 4).map(move |(t, _)| (k, t))
+            })
+            .collect()
+    };
+    if covered_by(&|t| opaque(triangles[t].material)).is_empty() {
+        return Vec::new();
+    }
+    let faces: Vec<usize> = (0..triangles.len()).filter(|&t| opaque(triangles[t].material)).collect();
+    let corners: Vec<[Vec3; 3]> = faces.iter().map(|&t| triangles[t].vertices).collect();
+    let vertices: Vec<[u32; 3]> = faces.iter().map(|&t| triangles[t].file_vertices).collect();
+    let (shells, _) = model_shells(&corners, &vertices);
+    let mut of_solid = vec![false; triangles.len()];
+    for (k, &t) in faces.iter().enumerate() {
+        of_solid[t] = shells.winding[k] == 1;
+    }
+    covered_by(&|t| of_solid[t])
 }
