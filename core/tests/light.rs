@@ -518,8 +518,6 @@ fn patches_are_fine_around_the_room_and_coarse_on_a_far_ground() {
 /// side's is closer than the default hemisphere rays alone get.
 #[test]
 fn rays_aimed_at_windows_read_the_sky_hemisphere_rays_read_with_less_noise() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("two_windows");
-    std::fs::create_dir_all(&dir).unwrap();
     let mut obj = quad_obj::QuadObj::new("room.mtl");
     let (w, d, h) = (4.0, 5.0, 3.0);
     obj.quad("floor", [[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
@@ -537,12 +535,7 @@ fn rays_aimed_at_windows_read_the_sky_hemisphere_rays_read_with_less_noise() {
         obj.quad("wall", [at(wb, 0.8), at(b, 0.8), at(b, 2.4), at(wb, 2.4)]);
         obj.quad("glass", [at(wa, 0.8), at(wb, 0.8), at(wb, 2.4), at(wa, 2.4)]);
     }
-    std::fs::write(dir.join("room.obj"), obj.text()).unwrap();
-    let mtl = "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl ceiling\nKd 0.8 0.8 0.8\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.12\n";
-    std::fs::write(dir.join("room.mtl"), mtl).unwrap();
-    let scene = "name = \"Corner room\"\n[site]\nlatitude = 40.78\nlongitude = -73.97\ntimezone = -5.0\n[model]\nobj = \"room.obj\"\n";
-    std::fs::write(dir.join("scene.toml"), scene).unwrap();
-    let scene = load(&dir.join("scene.toml"));
+    let scene = load(&write_room("two_windows", "Corner room", &obj, ""));
     let sky = sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "12:00");
     let sky_on_sides = |rays_per_patch: usize, window_rays_per_patch: usize| {
         let settings = LightSettings { rays_per_patch, window_rays_per_patch, ..LightSettings::default() };
@@ -597,6 +590,22 @@ fn add_to_room(path: &Path, quads: &quad_obj::QuadObj) {
         obj.push('\n');
     }
     std::fs::write(path.with_file_name("room.obj"), obj).unwrap();
+}
+
+/// Writes `obj` as `room.obj` in the test folder `folder`, with the rooms'
+/// materials (floor 0.3, ceiling 0.8, walls 0.5, glass of transmittance
+/// 0.88), and a scene file `name` in New York with `more` (sensors) after
+/// its model; returns the scene file's path.
+fn write_room(folder: &str, name: &str, obj: &quad_obj::QuadObj, more: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(folder);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("room.obj"), obj.text()).unwrap();
+    let mtl = "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl ceiling\nKd 0.8 0.8 0.8\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.12\n";
+    std::fs::write(dir.join("room.mtl"), mtl).unwrap();
+    let scene =
+        format!("name = \"{name}\"\n[site]\nlatitude = 40.78\nlongitude = -73.97\ntimezone = -5.0\n[model]\nobj = \"room.obj\"\n{more}");
+    std::fs::write(dir.join("scene.toml"), scene).unwrap();
+    dir.join("scene.toml")
 }
 
 /// Glass on a face of a solid in that face's plane (a window lining's
@@ -1110,8 +1119,6 @@ fn a_windowless_room_is_dark_though_its_floor_runs_on_outside() {
 #[test]
 fn light_passes_a_stack_of_five_panes() {
     let reading = |panes: usize| {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("panes_{panes}"));
-        std::fs::create_dir_all(&dir).unwrap();
         let mut obj = quad_obj::QuadObj::new("room.mtl");
         let (w, d, h) = (4.0, 6.0, 3.0);
         let (x0, x1, z0, z1) = (1.0, 3.0, 0.9, 2.3);
@@ -1135,15 +1142,8 @@ fn light_passes_a_stack_of_five_panes() {
             let y = -0.1 * k as f64 - 0.05;
             obj.quad("glass", [[x0, y, z0], [x1, y, z0], [x1, y, z1], [x0, y, z1]]);
         }
-        std::fs::write(dir.join("room.obj"), obj.text()).unwrap();
-        std::fs::write(
-            dir.join("room.mtl"),
-            "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl ceiling\nKd 0.8 0.8 0.8\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.12\n",
-        )
-        .unwrap();
-        let scene = "name = \"Panes\"\n[site]\nlatitude = 40.78\nlongitude = -73.97\ntimezone = -5.0\n[model]\nobj = \"room.obj\"\n\n[[sensors]]\nname = \"desk\"\nposition = [2.0, 2.0, 0.8]\nnormal = [0.0, 0.0, 1.0]\n";
-        std::fs::write(dir.join("scene.toml"), scene).unwrap();
-        let scene = load(&dir.join("scene.toml"));
+        let desk = "\n[[sensors]]\nname = \"desk\"\nposition = [2.0, 2.0, 0.8]\nnormal = [0.0, 0.0, 1.0]\n";
+        let scene = load(&write_room(&format!("panes_{panes}"), "Panes", &obj, desk));
         let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
         model.solve(&sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "12:00"), None).sensors[0].total
     };
@@ -1159,8 +1159,6 @@ fn light_passes_a_stack_of_five_panes() {
 /// its corner and the window it moves to where it sees the window.
 #[test]
 fn the_first_view_looks_into_one_room() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("two_rooms");
-    std::fs::create_dir_all(&dir).unwrap();
     let mut obj = quad_obj::QuadObj::new("room.mtl");
     let (w, d, h) = (8.0, 6.0, 3.0);
     room_on_ground::room_open_to_south(&mut obj, w, d, h);
@@ -1175,15 +1173,8 @@ fn the_first_view_looks_into_one_room() {
     for x in [1.0, 5.0] {
         obj.quad("glass", [[x, 0.0, 0.9], [x + 2.0, 0.0, 0.9], [x + 2.0, 0.0, 2.3], [x, 0.0, 2.3]]);
     }
-    std::fs::write(dir.join("room.obj"), obj.text()).unwrap();
-    std::fs::write(
-        dir.join("room.mtl"),
-        "newmtl floor\nKd 0.3 0.3 0.3\nnewmtl ceiling\nKd 0.8 0.8 0.8\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.12\n",
-    )
-    .unwrap();
-    let scene = "name = \"Two rooms\"\n[site]\nlatitude = 40.78\nlongitude = -73.97\ntimezone = -5.0\n[model]\nobj = \"room.obj\"\n";
-    std::fs::write(dir.join("scene.toml"), scene).unwrap();
-    let scene = load(&dir.join("scene.toml"));
+    let path = write_room("two_rooms", "Two rooms", &obj, "");
+    let scene = load(&path);
     let model = LightModel::unlit(scene.clone());
     assert_eq!(model.windows.groups.len(), 1, "both windows face south: one group");
     let view = model.interior_view().unwrap();
@@ -1200,8 +1191,8 @@ fn the_first_view_looks_into_one_room() {
     obj.quad("wall", [[x1, y0, 0.0], [x1, y1, 0.0], [x1, y1, h], [x1, y0, h]]);
     obj.quad("wall", [[x1, y1, 0.0], [x0, y1, 0.0], [x0, y1, h], [x1, y1, h]]);
     obj.quad("wall", [[x0, y1, 0.0], [x0, y0, 0.0], [x0, y0, h], [x0, y1, h]]);
-    std::fs::write(dir.join("room.obj"), obj.text()).unwrap();
-    let model = LightModel::unlit(load(&dir.join("scene.toml")));
+    std::fs::write(path.with_file_name("room.obj"), obj.text()).unwrap();
+    let model = LightModel::unlit(load(&path));
     let sight = |eye: glam::Vec3, target: glam::Vec3| {
         let clear = model.trace(eye.as_dvec3(), (target - eye).normalize().as_dvec3()).map_or(f64::INFINITY, |(_, d)| d);
         clear / f64::from(eye.distance(target))
