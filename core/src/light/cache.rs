@@ -26,7 +26,7 @@ use crate::sky::SkyPatches;
 
 const MAGIC: &[u8; 8] = b"HELIOLT\0";
 /// Bump when the model or its layout changes.
-const FORMAT: u32 = 19;
+const FORMAT: u32 = 20;
 
 /// What happened to the cache.
 #[derive(Debug, Clone, PartialEq, Eq)]
