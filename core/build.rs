@@ -1,6 +1,7 @@
 //! Hashes the crate's sources into `HELIODON_CORE_SOURCE_HASH`: the scene
-//! cache keys its files by it, so a loader that changes (how patches are
-//! cut, how an OBJ is read) never reads what an older one stored.
+//! cache and the light cache key their files by it, so a loader or a light
+//! engine that changes (how patches are cut, how an OBJ is read, how rays
+//! are gathered) never reads what an older one stored.
 
 use std::path::{Path, PathBuf};
 

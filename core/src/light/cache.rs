@@ -173,15 +173,20 @@ impl StableHash {
 /// nothing else. The patches' geometry (the model after loading, its frame
 /// and patch sizes), which materials pass light and how, which surface has
 /// which, the sensors' placement, and the settings that shape the result;
-/// not comments, names, reflectances, the site or the thread count.
+/// not comments, names, reflectances, the site or the thread count. And
+/// the code that computes them: the core's sources (`build.rs`'s hash, as
+/// the scene cache has it), so a build that gathers otherwise never reads
+/// what an older one stored, whether or not [`FORMAT`] was bumped (once it
+/// was not, and a changed gather read the last one's light).
 ///
 /// The sides left dark inside solids follow from what is hashed here (the
 /// model's triangles with their file's vertices, its surfaces and
 /// clusters, which materials pass light), so a warm start need not find
-/// them: a change to how they are found changes [`FORMAT`].
+/// them.
 pub fn key(scene: &Scene, settings: &LightSettings) -> u64 {
     let mut hash = StableHash::new();
     hash.bytes(MAGIC).u64(u64::from(FORMAT)).bytes(env!("CARGO_PKG_VERSION").as_bytes());
+    hash.bytes(env!("HELIODON_CORE_SOURCE_HASH").as_bytes());
     hash.blocks_of(&scene.patches.triangles, 1 << 14, |h, triangle| {
         h.points(triangle);
     });
