@@ -451,11 +451,16 @@ fn material_mesh(scene: &Scene, material: u32) -> Option<(Mesh, SurfaceValues)> 
 /// each facet alone showed its own patch's light as a blotch. Walls
 /// meeting a floor, a roof's two slopes, a surface's two sides stay apart.
 fn smooth_shallow_creases(nodes: &mut [Vec<(u32, f32)>], corners: &[([i64; 3], u32)], normals: &[Vec3]) {
-    for meeting in corners.chunk_by(|a, b| a.0 == b.0).filter(|m| m.len() > 1) {
+    let smooth = |a: u32, b: u32| a != b && normals[a as usize].dot(normals[b as usize]) >= SMOOTH_CREASE_COS;
+    for meeting in corners.chunk_by(|a, b| a.0 == b.0) {
+        // Most corners are creases alone (a box's): nothing to copy there.
+        if !meeting.iter().any(|&(_, a)| meeting.iter().any(|&(_, b)| smooth(a, b))) {
+            continue;
+        }
         let own: Vec<Vec<(u32, f32)>> = meeting.iter().map(|&(_, node)| nodes[node as usize].clone()).collect();
         for &(_, node) in meeting {
             for (&(_, other), sides) in meeting.iter().zip(&own) {
-                if other != node && normals[node as usize].dot(normals[other as usize]) >= SMOOTH_CREASE_COS {
+                if smooth(node, other) {
                     nodes[node as usize].extend_from_slice(sides);
                 }
             }

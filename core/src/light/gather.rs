@@ -661,7 +661,9 @@ impl LightModel {
         }
         let (u, v) = sampling::frame(normal);
         let corner = 0.5 * reach * std::f64::consts::FRAC_1_SQRT_2;
-        let corners = [centre, centre + corner * (u + v), centre + corner * (u - v), centre - corner * (u + v), centre - corner * (u - v)];
+        let all = [centre, centre + corner * (u + v), centre + corner * (u - v), centre - corner * (u + v), centre - corner * (u - v)];
+        // A point sensor has no corners: its centre alone.
+        let corners = if reach > 0.0 { &all[..] } else { &all[..1] };
         for (k, target) in targets.iter().enumerate() {
             // Seen from some point of the side: a vertex in front of its plane.
             if !target.triangles.iter().flat_map(|t| t.0).any(|v| normal.dot(v - centre) > WINDOW_IN_FRONT) {
