@@ -10,7 +10,7 @@ use super::bvh::ParallelHits;
 use super::measured::MeasuredSun;
 use super::openings::{OpeningsAlong, WayIn};
 use super::panels::{self, SunBeam};
-use super::sampling::{Rng, sample_area};
+use super::sampling::{Rng, sample_area, stratified_area_points};
 use super::{LightModel, SURFACE_OFFSET, Surface, par_map};
 use crate::sky::SunSource;
 
@@ -214,7 +214,7 @@ impl LightModel {
     }
 
     /// The beams on every diffuse patch side: shadow rays from `samples(side)`
-    /// seeded points of each side (0: not traced) that faces a beam and
+    /// stratified seeded points of each side (0: not traced) that faces a beam and
     /// that a beam may reach (`threads` as [`par_map`]). With
     /// `for_first_bounce` (the sensors' first bounce will read the reach),
     /// it keeps its [`Shadows`] on the sides where sensors' rays land and
@@ -242,7 +242,7 @@ impl LightModel {
             let mut rng = Rng::seeded(3, self.settings.seed, side as u64);
             let normal = self.side_normal(side as u32);
             let total: f64 =
-                (0..n).map(|_| sample_area(&triangles, &mut rng)).map(|point| self.reaching_irradiance(&reach, point, normal, beams)).sum();
+                stratified_area_points(&triangles, n, &mut rng).map(|point| self.reaching_irradiance(&reach, point, normal, beams)).sum();
             let reach = match reach {
                 _ if keep => reach,
                 Reach::Open(_) => Reach::Open(Shadows::default()),
