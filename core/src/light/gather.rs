@@ -934,8 +934,6 @@ mod tests {
     use std::fmt::Write as _;
 
     use super::*;
-    use crate::panel::PanelCatalog;
-    use crate::scene::load_scene;
 
     /// Appends an OBJ quad of `material`, moved `x0` along x.
     fn quad(obj: &mut String, material: &str, x0: f64, corners: [[f64; 3]; 4]) {
@@ -977,17 +975,9 @@ mod tests {
     const DESK: &str = "[[sensors]]\nname = \"desk\"\nposition = [2.0, 2.0, 0.8]\nnormal = [0.0, 0.0, 1.0]\n";
 
     /// The scene of `obj` (grey walls, clear glass) at 45° N, with `more`
-    /// (sensors) appended to its file, loaded from a folder of its own.
+    /// (sensors) appended to its file, shared.
     fn scene_of(name: &str, obj: &str, more: &str) -> Arc<Scene> {
-        let dir = std::env::temp_dir().join(format!("heliodon-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        std::fs::write(dir.join("m.obj"), format!("mtllib m.mtl\n{obj}")).unwrap();
-        std::fs::write(dir.join("m.mtl"), "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.8\n").unwrap();
-        let scene = format!("[site]\nlatitude = 45.0\nlongitude = 0.0\ntimezone = 0.0\n[model]\nobj = \"m.obj\"\n{more}");
-        std::fs::write(dir.join("scene.toml"), scene).unwrap();
-        let scene = Arc::new(load_scene(&dir.join("scene.toml"), &PanelCatalog::new()).unwrap().scene);
-        std::fs::remove_dir_all(&dir).ok();
-        scene
+        Arc::new(super::super::test_scene::scene_of(name, obj, more))
     }
 
     /// A room with a doorway and no window, and beside it a room closed but

@@ -489,6 +489,28 @@ impl LightModel {
     }
 }
 
+/// Scenes the light engine's unit tests build from OBJ text.
+#[cfg(test)]
+mod test_scene {
+    use crate::panel::PanelCatalog;
+    use crate::scene::{Scene, load_scene};
+
+    /// The scene of `obj` (materials `wall`, ρ 0.5, and `glass`) at 45° N,
+    /// with `more` added to its scene file: written to a temporary folder
+    /// named after `name` and read back.
+    pub(super) fn scene_of(name: &str, obj: &str, more: &str) -> Scene {
+        let dir = std::env::temp_dir().join(format!("heliodon-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("m.obj"), format!("mtllib m.mtl\n{obj}")).unwrap();
+        std::fs::write(dir.join("m.mtl"), "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.8\n").unwrap();
+        let scene = format!("[site]\nlatitude = 45.0\nlongitude = 0.0\ntimezone = 0.0\n[model]\nobj = \"m.obj\"\n{more}");
+        std::fs::write(dir.join("scene.toml"), scene).unwrap();
+        let scene = load_scene(&dir.join("scene.toml"), &PanelCatalog::new()).unwrap().scene;
+        std::fs::remove_dir_all(&dir).ok();
+        scene
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -134,11 +134,9 @@ fn open_shells_holding_windows(scene: &Scene, triangles: &[[glam::Vec3; 3]], she
 #[cfg(test)]
 mod tests {
     use std::fmt::Write as _;
-    use std::path::Path;
 
+    use super::super::test_scene::scene_of;
     use super::*;
-    use crate::panel::PanelCatalog;
-    use crate::scene::load_scene;
 
     /// The faces of a union of grid cells, each wound outward (or inward,
     /// `inward`), as OBJ quads of material `material`: cells `filled(i, j,
@@ -188,15 +186,6 @@ mod tests {
         }
     }
 
-    fn scene_of(dir: &Path, obj: &str) -> Scene {
-        std::fs::create_dir_all(dir).unwrap();
-        std::fs::write(dir.join("m.obj"), format!("mtllib m.mtl\n{obj}")).unwrap();
-        std::fs::write(dir.join("m.mtl"), "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl glass\nd 0.8\n").unwrap();
-        std::fs::write(dir.join("scene.toml"), "[site]\nlatitude = 45.0\nlongitude = 0.0\ntimezone = 0.0\n[model]\nobj = \"m.obj\"\n")
-            .unwrap();
-        load_scene(&dir.join("scene.toml"), &PanelCatalog::new()).unwrap().scene
-    }
-
     /// Per patch of material `name`: (front dark, back dark).
     fn dark_of(scene: &Scene, name: &str) -> Vec<(bool, bool)> {
         let material = scene.materials.iter().position(|m| m.name == name).unwrap() as u32;
@@ -215,30 +204,28 @@ mod tests {
     /// without one is dark inside.
     #[test]
     fn the_inside_of_a_solid_without_windows_is_dark() {
-        let dir = std::env::temp_dir().join(format!("heliodon-solids-{}", std::process::id()));
         let grid: [&[f64]; 3] = [&[0.0, 1.0, 3.0, 4.0], &[0.0, 0.3], &[0.0, 0.9, 2.3, 3.0]];
         let pane = "usemtl glass\nv 1 0.15 0.9\nv 3 0.15 0.9\nv 3 0.15 2.3\nv 1 0.15 2.3\nf -4 -3 -2 -1\n";
         let mut obj = String::new();
         cells_obj(&mut obj, "wall", grid, |c| c != [1, 0, 1], false);
-        let scene = scene_of(&dir.join("opening"), &(obj + pane));
+        let scene = scene_of("solids-opening", &(obj + pane), "");
         let wall = dark_of(&scene, "wall");
         assert!(wall.len() > 8 && wall.iter().all(|&d| d == (false, true)), "{wall:?}");
         assert!(dark_of(&scene, "glass").iter().all(|&d| d == (false, false)));
 
         let mut obj = String::new();
         cells_obj(&mut obj, "wall", grid, |_| true, false);
-        let scene = scene_of(&dir.join("no-opening"), &(obj + pane));
+        let scene = scene_of("solids-no-opening", &(obj + pane), "");
         assert!(dark_of(&scene, "wall").iter().all(|&d| d == (false, false)));
 
         let room: [&[f64]; 3] = [&[0.0, 4.0], &[0.0, 5.0], &[0.0, 3.0]];
         let mut obj = String::new();
         cells_obj(&mut obj, "wall", room, |_| true, true);
-        let closed = scene_of(&dir.join("closed-room"), &obj);
+        let closed = scene_of("solids-closed-room", &obj, "");
         let inside = dark_of(&closed, "wall");
         assert!(!inside.is_empty() && inside.iter().all(|&d| d == (true, false)), "{inside:?}");
         let on_the_wall = "usemtl glass\nv 1 0 0.9\nv 3 0 0.9\nv 3 0 2.3\nv 1 0 2.3\nf -1 -2 -3 -4\n";
-        let scene = scene_of(&dir.join("room-with-pane"), &(obj + on_the_wall));
+        let scene = scene_of("solids-room-with-pane", &(obj + on_the_wall), "");
         assert!(dark_of(&scene, "wall").iter().all(|&d| d == (false, false)));
-        std::fs::remove_dir_all(&dir).ok();
     }
 }
