@@ -201,9 +201,11 @@ impl Flat {
     }
 
     /// Where `face` meets the surface, or comes within [`CONTACT_GAP`] of
-    /// it, along a line inside it: the line's ends, in the surface's plane.
-    /// `None` when it lies wholly to one side, along the plane, or meets it
-    /// only at a point or outside the surface.
+    /// it, along a line inside it: the line's ends, in the surface's plane
+    /// (its corners within the gap, and where its edges cross the plane).
+    /// `None` when it lies wholly to one side, spans no more than twice the
+    /// gap across the plane (lying along it, or a sliver crossing it), or
+    /// meets it only at a point or outside the surface.
     fn contact(&self, face: &Triangle) -> Option<(Vec3, Vec3)> {
         let h = face.vertices.map(|p| self.normal.dot(p) - self.offset);
         let (low, high) = (h.iter().copied().fold(f32::INFINITY, f32::min), h.iter().copied().fold(f32::NEG_INFINITY, f32::max));
