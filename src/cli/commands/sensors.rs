@@ -35,6 +35,12 @@ pub fn run(args: &SensorsArgs, panels: &PanelCatalog) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The first five names and how many more: one warning line, however many sensors it is about.
+fn first_few(names: &[&str]) -> String {
+    let named = names.iter().take(5).copied().collect::<Vec<_>>().join(", ");
+    if names.len() > 5 { format!("{named} and {} more", names.len() - 5) } else { named }
+}
+
 /// The `sensors` command: one precomputation, then every date × time.
 pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, String> {
     let spec = args.sky.spec()?;
@@ -45,20 +51,23 @@ pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, Stri
     let outside: Vec<&str> =
         model.open_sky_shares().iter().zip(&scene.sensors).filter(|(share, _)| **share > OUTSIDE).map(|(_, s)| s.name.as_str()).collect();
     if !outside.is_empty() {
-        let named = outside.iter().take(5).copied().collect::<Vec<_>>().join(", ");
-        let more = if outside.len() > 5 { format!(" and {} more", outside.len() - 5) } else { String::new() };
+        let named = first_few(&outside);
         let what = if outside.len() == scene.sensors.len() {
             "every sensor sees the open sky directly: the model has no enclosed room around them"
         } else {
             "sensors outside every room (they see the open sky directly)"
         };
-        eprintln!("warning: {}: {what}: {named}{more}; they read the light where they are", args.scene.display());
+        eprintln!("warning: {}: {what}: {named}; they read the light where they are", args.scene.display());
     }
-    for i in model.sensors_inside_solids() {
+    let inside: Vec<&str> = model.sensors_inside_solids().into_iter().map(|i| scene.sensors[i].name.as_str()).collect();
+    if !inside.is_empty() {
         eprintln!(
-            "warning: {}: sensor '{}' seems to be inside a solid (every direction meets a back face); it reads what reaches it there",
+            "warning: {}: {} inside a solid (every direction meets a back face): {}; {} what reaches {} there",
             args.scene.display(),
-            scene.sensors[i].name
+            if inside.len() == 1 { "a sensor seems to be" } else { "sensors seem to be" },
+            first_few(&inside),
+            if inside.len() == 1 { "it reads" } else { "they read" },
+            if inside.len() == 1 { "it" } else { "them" },
         );
     }
     let cases: Vec<LocalDateTime> =
