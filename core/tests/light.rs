@@ -1054,6 +1054,84 @@ fn no_light_leaks_round_the_glass_of_a_thick_wall() {
     }
 }
 
+/// A 24 × 24 cm tile, 5 mm thick, lying on the floor is too small to cut
+/// the floor's patches, so the floor patch under it is partly inside a
+/// solid, where no light reaches. That part is left out of the patch's
+/// light: the rest, which the room sees, reads the sun and the overcast
+/// sky's light that the same floor reads without the tile. Averaged with
+/// the dark part, as before, it read a quarter less. (In the sun, the
+/// tile's sunlit edge lights the floor beside it: real light that the bare
+/// floor lacks, so the clear sky's diffuse light is not compared.)
+#[test]
+fn a_patch_partly_under_a_solid_reads_the_light_of_its_uncovered_part() {
+    let (x, y, side, height) = (1.63, 1.13, 0.24, 0.005);
+    let scene_with = |name: &str, tile: bool| {
+        let path = on_a_ground(name, 10.0, 10.0, true);
+        if tile {
+            let mut quads = quad_obj::QuadObj::new("room.mtl");
+            let (a, b, c, d, e) = (x, x + side, y, y + side, height);
+            quads.quad("wall", [[a, c, 0.0], [a, d, 0.0], [b, d, 0.0], [b, c, 0.0]]);
+            quads.quad("wall", [[a, c, e], [b, c, e], [b, d, e], [a, d, e]]);
+            quads.quad("wall", [[a, c, 0.0], [b, c, 0.0], [b, c, e], [a, c, e]]);
+            quads.quad("wall", [[a, d, 0.0], [a, d, e], [b, d, e], [b, d, 0.0]]);
+            quads.quad("wall", [[a, c, 0.0], [a, c, e], [a, d, e], [a, d, 0.0]]);
+            quads.quad("wall", [[b, c, 0.0], [b, d, 0.0], [b, d, e], [b, c, e]]);
+            add_to_room(&path, &quads);
+        }
+        load(&path)
+    };
+    // The floor patch holding a point (the floor faces up, at z = 0).
+    let floor_patch_at = |scene: &Scene, px: f32, py: f32| {
+        let inside = |t: &[glam::Vec3; 3]| {
+            let edge = |a: glam::Vec3, b: glam::Vec3| (b.x - a.x) * (py - a.y) - (b.y - a.y) * (px - a.x);
+            let (e0, e1, e2) = (edge(t[0], t[1]), edge(t[1], t[2]), edge(t[2], t[0]));
+            (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0) || (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0)
+        };
+        let mesh = &scene.patches;
+        (0..mesh.patches.len())
+            .find(|&p| {
+                let patch = &mesh.patches[p];
+                scene.materials[patch.material as usize].name == "floor"
+                    && mesh.triangles[patch.triangles.start as usize..patch.triangles.end as usize].iter().any(&inside)
+            })
+            .expect("a floor patch there")
+    };
+    let (bare, tiled) = (scene_with("floor_bare", false), scene_with("floor_tiled", true));
+    let corners = [(x, y), (x + side, y), (x, y + side), (x + side, y + side)].map(|(cx, cy)| (cx as f32, cy as f32));
+    let patch = floor_patch_at(&tiled, corners[0].0 + 0.01, corners[0].1 + 0.01);
+    for (cx, cy) in corners {
+        let inward = |v: f32, low: f64| if f64::from(v) == low { v + 0.01 } else { v - 0.01 };
+        assert_eq!(floor_patch_at(&tiled, inward(cx, x), inward(cy, y)), patch, "the tile lies within one floor patch");
+    }
+    let covered = (side * side) as f32 / tiled.patches.patches[patch].area;
+    let floor_side = |scene: &Scene| {
+        let p = floor_patch_at(scene, corners[0].0 + 0.01, corners[0].1 + 0.01) as u32;
+        heliodon_core::light::side_of(p, scene.patches.patches[p as usize].normal.z < 0.0) as usize
+    };
+    let bare_model = LightModel::precompute(bare.clone(), LightSettings::default()).unwrap();
+    let tiled_model = LightModel::precompute(tiled.clone(), LightSettings::default()).unwrap();
+    let buried = tiled_model.side_gather(floor_side(&tiled)).buried;
+    println!("the tile covers {:.1}% of its floor patch; {:.1}% of the patch's sun points are under it", 100.0 * covered, 100.0 * buried);
+    assert!((buried - covered).abs() < 0.06, "buried share {buried}, covered {covered}");
+    let irradiance = |spec: &SkySpec, scene: &Arc<Scene>, model: &LightModel| {
+        let light = &model.solve(&sky_at(scene, spec, "2026-03-21", "12:00"), None).sides[floor_side(scene)];
+        (light.sun, light.sky + light.indirect[1])
+    };
+    let overcast = [irradiance(&SkySpec::Overcast, &bare, &bare_model).1, irradiance(&SkySpec::Overcast, &tiled, &tiled_model).1];
+    println!("overcast: sky and interreflected {:.2} W/m² bare, {:.2} tiled", overcast[0], overcast[1]);
+    assert!(
+        (overcast[1] - overcast[0]).abs() < 0.05 * overcast[0],
+        "overcast: {} W/m² on the tiled patch, {} bare",
+        overcast[1],
+        overcast[0]
+    );
+    // Noon at the equinox: the patch lies in the window's sun patch.
+    let clear = SkySpec::Clear { turbidity: 2.45 };
+    let sun = [irradiance(&clear, &bare, &bare_model).0, irradiance(&clear, &tiled, &tiled_model).0];
+    println!("clear noon: sun {:.1} W/m² bare, {:.1} tiled", sun[0], sun[1]);
+    assert!((sun[1] - sun[0]).abs() < 0.05 * sun[0], "sun {} W/m² on the tiled patch, {} bare", sun[1], sun[0]);
+}
+
 /// A window's outward side is the one that sees the sky; glazing that sees
 /// none from either side (a pane between two rooms, or glass shut inside a
 /// door leaf) is said to be enclosed, not given a guessed facing.

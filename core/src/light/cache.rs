@@ -26,7 +26,7 @@ use crate::sky::SkyPatches;
 
 const MAGIC: &[u8; 8] = b"HELIOLT\0";
 /// Bump when the model or its layout changes.
-const FORMAT: u32 = 20;
+const FORMAT: u32 = 21;
 
 /// What happened to the cache.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -714,6 +714,13 @@ impl Writer {
     pub fn gather(&mut self, g: &Gather) {
         self.pairs(&g.daylight_coefficients);
         self.pairs(&g.form_factors);
+        // Most sides have nothing buried: one byte.
+        if g.buried == 0.0 {
+            self.varint(0);
+        } else {
+            self.varint(1);
+            self.f32(g.buried);
+        }
     }
 }
 
@@ -816,7 +823,13 @@ impl Reader<'_> {
     }
 
     pub fn gather(&mut self) -> Option<Gather> {
-        Some(Gather { daylight_coefficients: self.pairs()?, form_factors: self.pairs()? })
+        let (daylight_coefficients, form_factors) = (self.pairs()?, self.pairs()?);
+        let buried = match self.varint()? {
+            0 => 0.0,
+            1 => self.f32()?,
+            _ => return None,
+        };
+        Some(Gather { daylight_coefficients, form_factors, buried })
     }
 
     pub fn is_empty(&self) -> bool {

@@ -16,7 +16,8 @@ use glam::DVec3;
 use super::bvh::Tracer;
 use super::landings::Landings;
 use super::openings::{LEAST_JOINING_SHARE, SPACE_MEMBER, Spaces};
-use super::sampling::{self, Rng, cosine_directions, sample_area, with_cumulative_areas};
+use super::sampling::{self, Rng, cosine_directions, sample_area, stratified_area_points, with_cumulative_areas};
+use super::sun::SUN_POINTS_STREAM;
 use super::{LightModel, LightSettings, MAX_GLASS_DEPTH, MIN_WEIGHT, SURFACE_OFFSET, Surface, par_map, side_of};
 use crate::parallel::par_join;
 use crate::scene::{Scene, Sensor};
@@ -50,6 +51,10 @@ pub(super) fn check_memory(scene: &Scene, settings: &LightSettings) -> Result<()
 
 /// Sensors closer than this to a surface behind them read as lifted this far.
 const SENSOR_LIFT: f64 = 0.01;
+
+/// Rays that tell a patch's point inside a solid from a seam a ray
+/// slipped through ([`LightModel::is_buried`]).
+const BURIED_PROBES: usize = 3;
 
 /// Rays from each sensor that find the patch sides it sees
 /// ([`LightModel::probe_sensors`]).
@@ -157,6 +162,14 @@ pub struct Gather {
     pub daylight_coefficients: Vec<(u32, f32)>,
     /// Patch sides ([`side_of`]) with their shares, sorted by side.
     pub form_factors: Vec<(u32, f32)>,
+    /// The share of a patch side's sun points inside a solid (under a face
+    /// resting on it that cut no patch there: a tile, a skirting board, a
+    /// slab through a wall), where no light reaches, so that its sun
+    /// (`sun_on_sides`) is the mean over the rest, the part the room sees,
+    /// as the shares above are (their rays from such points are left out).
+    /// Found where the side's rays met a solid's inside and the sky; 0 for
+    /// sensors.
+    pub buried: f32,
 }
 
 /// A sky or ground bin as a receiver sees it: straight (no window between,
@@ -313,6 +326,11 @@ fn unglazed_sides(hits: &[SideHit], rays: usize) -> Vec<u32> {
 }
 
 impl Gather {
+    /// The share of the side's area the room sees (see [`Self::buried`]).
+    pub fn visible(&self) -> f64 {
+        1.0 - f64::from(self.buried)
+    }
+
     fn from_raw(mut coefficients: Vec<(u32, f64)>, hits: &[SideHit], rays: usize) -> Self {
         let mut sides: Vec<(u32, f64)> = hits.iter().map(|h| (h.side, h.weight)).collect();
         let merge = |v: &mut Vec<(u32, f64)>| -> Vec<(u32, f32)> {
@@ -326,7 +344,7 @@ impl Gather {
             }
             out
         };
-        Self { daylight_coefficients: merge(&mut coefficients), form_factors: merge(&mut sides) }
+        Self { daylight_coefficients: merge(&mut coefficients), form_factors: merge(&mut sides), buried: 0.0 }
     }
 }
 
@@ -445,7 +463,7 @@ impl LightModel {
                 (_, Some(b)) if share(&b.settings, side, sight) == own => (b.side_gathers[side].clone(), false, Vec::new()),
                 (None, _) => (nothing.clone(), false, Vec::new()),
                 (Some(own), beside) => {
-                    let (traced, unglazed) = model.gather_patch_side(side, &targets, own);
+                    let (traced, unglazed) = model.gather_patch_side(side, &targets, own, dark);
                     match beside.map(|b| &b.side_gathers[side]) {
                         // Glass gathers nothing, whatever its rays.
                         Some(theirs) if **theirs == traced => (theirs.clone(), true, unglazed),
@@ -587,7 +605,7 @@ impl LightModel {
     /// drawn its path (through a window not aimed at, or after glass
     /// turned it back), so every path to the sky is counted once.
     /// Also returns the sides its rays met crossing no window.
-    fn gather_patch_side(&self, side: usize, targets: &[WindowTarget], share: f64) -> (Gather, Vec<u32>) {
+    fn gather_patch_side(&self, side: usize, targets: &[WindowTarget], share: f64, dark: &[bool]) -> (Gather, Vec<u32>) {
         let patch_index = side / 2;
         let gathers = match self.surface_of_patch(patch_index as u32) {
             Surface::Diffuse(_) => true,
@@ -611,13 +629,68 @@ impl LightModel {
         let (mut coefficients, mut hits) = (Vec::new(), Vec::new());
         // The sky straight through an aimed-at window is the aimed rays'.
         let not_aimed = |way: Way| way.reflected || !way.window.is_some_and(aimed_window);
+        // Rays from points inside a solid (under a face resting on the
+        // patch that cut it nowhere) are left out: each estimate below is
+        // the mean over the part of the side the room sees.
+        let mut probe_rng = Rng::seeded(6, self.settings.seed, side as u64);
+        let mut from_inside = |point: DVec3, first: Option<&SideHit>| {
+            first.is_some_and(|hit| dark[hit.side as usize]) && self.is_buried(point, normal, dark, &mut probe_rng)
+        };
+        let mut buried = 0;
         for dir in directions {
             let point = sample_area(&triangles, &mut rng) + normal * SURFACE_OFFSET;
+            let before = (coefficients.len(), hits.len());
             self.follow(point, dir, 1.0, 0, Way::START, &not_aimed, &mut coefficients, &mut hits);
+            if from_inside(point, hits.get(before.1)) {
+                coefficients.truncate(before.0);
+                hits.truncate(before.1);
+                buried += 1;
+            }
         }
+        let seen_rays = if buried < hemisphere { hemisphere - buried } else { hemisphere };
+        let aimed_from = coefficients.len();
         let aiming = Aiming { normal, aimed: &aimed, targets, rays: window_rays, hemisphere };
-        self.aim_at_windows(&aiming, &mut rng, Eyes::Spread { triangles: &triangles, lift: normal * SURFACE_OFFSET }, &mut coefficients);
-        (Gather::from_raw(coefficients, &hits, hemisphere), unglazed_sides(&hits, hemisphere))
+        let eyes = Eyes::Spread { triangles: &triangles, lift: normal * SURFACE_OFFSET };
+        let aimed_inside = self.aim_at_windows(&aiming, &mut rng, eyes, &mut coefficients, &mut from_inside);
+        if buried > 0 || aimed_inside > 0 {
+            // The aimed rays' weights are in the units of all hemisphere rays.
+            let outside = window_rays.saturating_sub(aimed_inside).max(1);
+            let scale = seen_rays as f64 / hemisphere as f64 * window_rays as f64 / outside as f64;
+            coefficients[aimed_from..].iter_mut().for_each(|(_, weight)| *weight *= scale);
+        }
+        // A side none of whose rays found the sky sees no sun either.
+        let sees_sky = !coefficients.is_empty();
+        let sun_points_buried = if buried > 0 && sees_sky { self.sun_points_buried(side, normal, dark, &mut probe_rng) } else { 0.0 };
+        let gather = Gather { buried: sun_points_buried, ..Gather::from_raw(coefficients, &hits, seen_rays) };
+        (gather, unglazed_sides(&hits, hemisphere))
+    }
+
+    /// Whether a point whose ray met a side inside a solid (`dark`) lies in
+    /// that solid: [`BURIED_PROBES`] more rays from it meet such sides too.
+    /// A ray that slipped through a seam between two faces into a wall has
+    /// open air behind it, and is kept.
+    fn is_buried(&self, point: DVec3, normal: DVec3, dark: &[bool], rng: &mut Rng) -> bool {
+        cosine_directions(normal, BURIED_PROBES, rng).into_iter().all(|dir| self.meets_dark_side(point, dir, dark))
+    }
+
+    /// Whether the ray from `point` along `dir` first meets a side inside a solid.
+    fn meets_dark_side(&self, point: DVec3, dir: DVec3, dark: &[bool]) -> bool {
+        self.tracer()
+            .closest(point, dir, 1e-6)
+            .is_some_and(|hit| dark[side_of(hit.patch, dir.dot(self.patch_normal(hit.patch)) > 0.0) as usize])
+    }
+
+    /// The share of `side`'s sun points (the ones `sun_on_sides` draws)
+    /// inside a solid, so its sun is their mean over the others
+    /// ([`Gather::buried`]); 0 where all are.
+    fn sun_points_buried(&self, side: usize, normal: DVec3, dark: &[bool], rng: &mut Rng) -> f32 {
+        let n = self.sun_samples(side);
+        let mut points_rng = Rng::seeded(SUN_POINTS_STREAM, self.settings.seed, side as u64);
+        let inside = stratified_area_points(&self.patch_triangles(side / 2), n, &mut points_rng)
+            .map(|point| point + normal * SURFACE_OFFSET)
+            .filter(|&origin| self.meets_dark_side(origin, normal, dark) && self.is_buried(origin, normal, dark, rng))
+            .count();
+        if inside < n { (inside as f64 / n as f64) as f32 } else { 0.0 }
     }
 
     /// Traces `aiming.rays` rays aimed at its windows from `eyes`, adding
@@ -627,10 +700,20 @@ impl LightModel {
     /// by cos·Ω/(π P) for the solid angle Ω its direction was drawn from
     /// and the odds P of its window, in units of the receiver's
     /// `aiming.hemisphere` hemisphere rays.
-    fn aim_at_windows(&self, aiming: &Aiming, rng: &mut Rng, eyes: Eyes, coefficients: &mut Vec<(u32, f64)>) {
+    /// Rays from an eye that `from_inside` finds inside a solid (given the
+    /// first side the ray met) add nothing; returns how many there were.
+    fn aim_at_windows(
+        &self,
+        aiming: &Aiming,
+        rng: &mut Rng,
+        eyes: Eyes,
+        coefficients: &mut Vec<(u32, f64)>,
+        from_inside: &mut dyn FnMut(DVec3, Option<&SideHit>) -> bool,
+    ) -> usize {
         let Aiming { normal, aimed, targets, rays, hemisphere } = *aiming;
         let odds_total: f64 = aimed.iter().map(|a| a.odds).sum();
         let mut ignored = Vec::new();
+        let mut inside = 0;
         // Per fixed eye and near window, its triangles' solid angles.
         let mut seen: HashMap<(usize, usize), Vec<f64>> = HashMap::new();
         for j in (0..rays).filter(|_| !aimed.is_empty()) {
@@ -658,9 +741,15 @@ impl LightModel {
             }
             let weight = cos_here * solid_angle / (std::f64::consts::PI * aim.odds / odds_total) * hemisphere as f64 / rays as f64;
             let straight_through = |way: Way| !way.reflected && way.window == Some(target.window);
+            let before = coefficients.len();
             self.follow(point, dir, weight, 0, Way::START, &straight_through, coefficients, &mut ignored);
+            if from_inside(point, ignored.first()) {
+                coefficients.truncate(before);
+                inside += 1;
+            }
             ignored.clear();
         }
+        inside
     }
 
     /// The windows a receiver (a patch side, a sensor) at `centre`, `reach`
@@ -839,7 +928,7 @@ impl LightModel {
         let unglazed = unglazed_sides(&hits, rays);
         self.retrace_sky_edges(&strata, normal, &not_aimed, &mut rng, &mut coefficients, &mut hits);
         let aiming = Aiming { normal, aimed: &aimed, targets, rays: self.settings.window_rays_per_sensor, hemisphere: rays };
-        self.aim_at_windows(&aiming, &mut rng, Eyes::Fixed(&points), &mut coefficients);
+        self.aim_at_windows(&aiming, &mut rng, Eyes::Fixed(&points), &mut coefficients, &mut |_, _| false);
         (SensorGeometry::new(Gather::from_raw(coefficients, &hits, rays), sun_points, normal, landings), unglazed)
     }
 

@@ -75,6 +75,10 @@ pub(super) struct SensorsSun<'a> {
     measured: &'a MeasuredSun,
 }
 
+/// The random stream of a patch side's sun points (`sun_on_sides`),
+/// which the gather also draws to find those inside a solid.
+pub(super) const SUN_POINTS_STREAM: u64 = 3;
+
 /// The fewest rays along a beam (sun samples, and the sensors' landings
 /// where their first bounce reads the side) for which a side finds its
 /// [`Shadows`]: the traversal costs about as much as a dozen rays, the sun
@@ -239,7 +243,7 @@ impl LightModel {
                 return (0.0, reach);
             }
             let triangles = self.patch_triangles(side / 2);
-            let mut rng = Rng::seeded(3, self.settings.seed, side as u64);
+            let mut rng = Rng::seeded(SUN_POINTS_STREAM, self.settings.seed, side as u64);
             let normal = self.side_normal(side as u32);
             let total: f64 =
                 stratified_area_points(&triangles, n, &mut rng).map(|point| self.reaching_irradiance(&reach, point, normal, beams)).sum();
@@ -249,7 +253,10 @@ impl LightModel {
                 Reach::Through(ways, _) => Reach::Through(ways, Shadows::default()),
                 Reach::None => Reach::None,
             };
-            (total / n as f64, reach)
+            // The mean over the part of the side the room sees
+            // (`Gather::buried`, found on the `sun_samples` points: exact
+            // for those, an estimate for the sun path's other counts).
+            (total / n as f64 / self.side_gathers[side].visible(), reach)
         });
         let (irradiance, reach) = sides.into_iter().unzip();
         SidesSun { irradiance, reach: SidesReach::new(reach) }
