@@ -41,6 +41,11 @@ const CONTACT_REACH: f32 = 0.01;
 /// entrance hall read 7-9 lx where Radiance reads 0.9-1.5).
 const CONTACT_GAP: f32 = 0.01;
 
+/// How far to either side of a contact line its points are looked for in
+/// the surface's triangles, where the line runs along an edge between two
+/// of them.
+const ACROSS_EDGE: f32 = 0.002;
+
 /// A plane: its unit normal and offset (the points x with normal · x = offset).
 pub type Plane = (Vec3, f32);
 
@@ -226,7 +231,14 @@ impl Flat {
         if p.distance(q) < MIN_CONTACT {
             return None;
         }
-        let inside = [0.1, 0.3, 0.5, 0.7, 0.9].iter().any(|&t| self.holds(p.lerp(q, t)));
+        // A line along an edge between two of the surface's own triangles
+        // (a wall triangulated along the slab's top) is inside it where
+        // the surface lies on both sides of it.
+        let across = self.normal.cross(q - p).normalize_or_zero() * ACROSS_EDGE;
+        let inside = [0.1, 0.3, 0.5, 0.7, 0.9]
+            .iter()
+            .map(|&t| p.lerp(q, t))
+            .any(|x| self.holds(x) || (self.holds(x + across) && self.holds(x - across)));
         inside.then_some((p, q))
     }
 
@@ -350,6 +362,25 @@ mod tests {
         assert!(cuts[1].is_empty(), "{:?}", cuts[1]);
         // A face half a metre above and one lying flat on the slab cut nothing.
         assert!(cuts[2].is_empty() && cuts[3].is_empty());
+    }
+
+    /// A slab meeting a wall whose triangles have an edge along the slab's
+    /// top (as IFC exports triangulate a storey's wall) cuts it there, as
+    /// it cuts a wall whose triangles cross that line. Before, the line
+    /// lay inside none of the wall's triangles and the wall's patches
+    /// spanned the slab, lit as the mean of the storey below and above.
+    #[test]
+    fn a_slab_meeting_a_wall_along_an_edge_of_its_triangles_cuts_it() {
+        let below = quad(1, [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 0.0, 2.7], [0.0, 0.0, 2.7]]);
+        let above = quad(1, [[0.0, 0.0, 2.7], [4.0, 0.0, 2.7], [4.0, 0.0, 5.0], [0.0, 0.0, 5.0]]);
+        let whole = quad(1, [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 0.0, 5.0], [0.0, 0.0, 5.0]]);
+        let slab_top = quad(0, [[0.0, 0.0, 2.7], [0.0, -3.0, 2.7], [4.0, -3.0, 2.7], [4.0, 0.0, 2.7]]);
+        for wall in [[below, above].concat(), whole] {
+            let (triangles, surfaces) = surfaces(&[wall, slab_top.clone()]);
+            let cuts = contact_cuts(&LargeFaces::new(&triangles, &surfaces, 0.01), &surfaces);
+            assert_eq!(cuts[0].len(), 1, "{:?}", cuts[0]);
+            assert!(cuts[0][0].normal.z.abs() > 0.999 && (cuts[0][0].offset.abs() - 2.7).abs() < 1e-5, "{:?}", cuts[0][0]);
+        }
     }
 
     /// A door leaf 4 mm over its threshold parts the light on it as a wall
