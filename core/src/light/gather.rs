@@ -660,7 +660,8 @@ impl LightModel {
         }
         // A side none of whose rays found the sky sees no sun either.
         let sees_sky = !coefficients.is_empty();
-        let sun_points_buried = if buried > 0 && sees_sky { self.sun_points_buried(side, normal, dark, &mut probe_rng) } else { 0.0 };
+        let sun_points_buried =
+            if buried > 0 && sees_sky { self.sun_points_buried(side, &triangles, normal, dark, &mut probe_rng) } else { 0.0 };
         let gather = Gather { buried: sun_points_buried, ..Gather::from_raw(coefficients, &hits, seen_rays) };
         (gather, unglazed_sides(&hits, hemisphere))
     }
@@ -680,13 +681,13 @@ impl LightModel {
             .is_some_and(|hit| dark[side_of(hit.patch, dir.dot(self.patch_normal(hit.patch)) > 0.0) as usize])
     }
 
-    /// The share of `side`'s sun points (the ones `sun_on_sides` draws)
-    /// inside a solid, so its sun is their mean over the others
-    /// ([`Gather::buried`]); 0 where all are.
-    fn sun_points_buried(&self, side: usize, normal: DVec3, dark: &[bool], rng: &mut Rng) -> f32 {
+    /// The share of `side`'s sun points (the ones `sun_on_sides` draws from
+    /// its `triangles`) inside a solid, so its sun is their mean over the
+    /// others ([`Gather::buried`]); 0 where all are.
+    fn sun_points_buried(&self, side: usize, triangles: &[([DVec3; 3], f64)], normal: DVec3, dark: &[bool], rng: &mut Rng) -> f32 {
         let n = self.sun_samples(side);
         let mut points_rng = Rng::seeded(SUN_POINTS_STREAM, self.settings.seed, side as u64);
-        let inside = stratified_area_points(&self.patch_triangles(side / 2), n, &mut points_rng)
+        let inside = stratified_area_points(triangles, n, &mut points_rng)
             .map(|point| point + normal * SURFACE_OFFSET)
             .filter(|&origin| self.meets_dark_side(origin, normal, dark) && self.is_buried(origin, normal, dark, rng))
             .count();

@@ -61,13 +61,15 @@ pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, Stri
     }
     let inside: Vec<&str> = model.sensors_inside_solids().into_iter().map(|i| scene.sensors[i].name.as_str()).collect();
     if !inside.is_empty() {
+        let (who, reads) = if inside.len() == 1 {
+            ("a sensor seems to be", "it reads what reaches it")
+        } else {
+            ("sensors seem to be", "they read what reaches them")
+        };
         eprintln!(
-            "warning: {}: {} inside a solid (every direction meets a back face): {}; {} what reaches {} there",
+            "warning: {}: {who} inside a solid (every direction meets a back face): {}; {reads} there",
             args.scene.display(),
-            if inside.len() == 1 { "a sensor seems to be" } else { "sensors seem to be" },
-            first_few(&inside),
-            if inside.len() == 1 { "it reads" } else { "they read" },
-            if inside.len() == 1 { "it" } else { "them" },
+            first_few(&inside)
         );
     }
     let cases: Vec<LocalDateTime> =
