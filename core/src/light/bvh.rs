@@ -17,6 +17,14 @@ use obvhs::triangle::Triangle;
 
 use crate::scene::PatchMesh;
 
+/// obvhs's traversal passes over a box the ray leaves within 0.1 mm of its
+/// start (`CwBvhNode::intersect_ray` clamps the entry to 1e-4): a ray from
+/// a patch's point that close to a wall meeting it went through the wall
+/// (a ceiling's corner patch in a closed room saw the sky below the ground
+/// beyond it). Rays start this far (m) behind their origin instead, and
+/// count hits from the origin on.
+const STEP_BACK: f64 = 2e-4;
+
 fn to_bvh(v: DVec3) -> Vec3A {
     Vec3A::new(v.x as f32, v.y as f32, v.z as f32)
 }
@@ -120,11 +128,11 @@ impl Tracer {
         // obvhs picks the traversal octant from the sign bits: a −0.0 component
         // (from negating an axis) must become +0.0 or axis-aligned rays miss.
         let direction = direction + DVec3::ZERO;
-        let ray = Ray::new(to_bvh(origin), to_bvh(direction), t_min as f32, f32::INFINITY);
+        let ray = Ray::new(to_bvh(origin - direction * STEP_BACK), to_bvh(direction), (t_min + STEP_BACK) as f32, f32::INFINITY);
         let mut hit = RayHit::none();
         self.bvh
             .ray_traverse(ray, &mut hit, |ray, id| self.triangles[id].intersect(ray))
-            .then(|| Hit { patch: self.owner[hit.primitive_id as usize], distance: f64::from(hit.t) })
+            .then(|| Hit { patch: self.owner[hit.primitive_id as usize], distance: f64::from(hit.t) - STEP_BACK })
     }
 
     /// Every surface along a ray between `t_min` and `t_max`, in no
@@ -132,14 +140,15 @@ impl Tracer {
     /// shadow rays through glass, which stops at the first opaque surface.
     pub fn each_hit(&self, origin: DVec3, direction: DVec3, t_min: f64, t_max: f64, mut visit: impl FnMut(Hit) -> bool) {
         let direction = direction + DVec3::ZERO;
-        let ray = Ray::new(to_bvh(origin), to_bvh(direction), t_min as f32, t_max as f32);
+        let ray =
+            Ray::new(to_bvh(origin - direction * STEP_BACK), to_bvh(direction), (t_min + STEP_BACK) as f32, (t_max + STEP_BACK) as f32);
         let mut state = self.bvh.new_traversal(ray.direction);
         let mut node;
         'traversal: {
             obvhs::traverse!(self.bvh, node, state, node.intersect_ray(&ray, state.oct_inv4), {
                 let triangle = state.primitive_id as usize;
                 let t = self.triangles[triangle].intersect(&ray);
-                if t < ray.tmax && !visit(Hit { patch: self.owner[triangle], distance: f64::from(t) }) {
+                if t < ray.tmax && !visit(Hit { patch: self.owner[triangle], distance: f64::from(t) - STEP_BACK }) {
                     break 'traversal;
                 }
             });
@@ -253,6 +262,29 @@ mod tests {
     use super::*;
     use crate::scene::{Patch, PatchMesh};
     use glam::Vec3;
+
+    /// A ray from a point a hundredth of a millimetre from a wall, toward
+    /// it, meets it (obvhs's traversal alone passed over the wall's box: a
+    /// ceiling's corner patch saw through the wall beside it).
+    #[test]
+    fn a_ray_from_a_hair_off_a_wall_meets_it() {
+        let v = |y: f32, z: f32| Vec3::new(0.0, y, z);
+        let wall = [[v(0.0, 0.0), v(6.0, 0.0), v(6.0, 3.0)], [v(0.0, 0.0), v(6.0, 3.0), v(0.0, 3.0)]];
+        let tracer = Tracer::over(&wall, vec![7, 7]);
+        let origin = DVec3::new(1.2e-5, 0.39, 2.9999);
+        let direction = DVec3::new(-0.852, 0.392, -0.346).normalize();
+        let hit = tracer.closest(origin, direction, 1e-6).expect("the wall");
+        assert_eq!(hit.patch, 7);
+        assert!((hit.distance - 1.2e-5 / direction.x.abs()).abs() < 1e-6, "{}", hit.distance);
+        let mut met = Vec::new();
+        tracer.each_hit(origin, direction, 1e-6, 1.0, |hit| {
+            met.push(hit.patch);
+            true
+        });
+        assert_eq!(met, [7]);
+        // Nor does stepping back meet what lies behind the origin.
+        assert!(tracer.closest(origin, -direction, 1e-6).is_none());
+    }
 
     #[test]
     fn axis_aligned_rays_with_negative_zeros_hit() {
