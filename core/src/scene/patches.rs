@@ -6,7 +6,9 @@
 //! *focus* (around the sensors and the windows within a few metres of
 //! them, with a margin; around all the windows when there are no
 //! sensors), and growing with the distance from it (a quarter of that
-//! distance, at most 64 × `patch_size`). So a room keeps today's grid,
+//! distance, at most 64 × `patch_size`); away from the windows, patches
+//! may be as wide as half their distance from the sensors, at most twice
+//! `patch_size` (a tall room's ceiling over its grid). So a room keeps today's grid,
 //! while the far ground, the site's context, the outside of the building
 //! far from its windows and the wings and storeys where no sensor reads
 //! get a few large patches. A patch is one leaf cell's part of the surface;
@@ -142,6 +144,11 @@ const SENSOR_CUBE: f32 = 2.0;
 /// A window lights the sensors when it lies within this distance (m) of
 /// one: the windows of a sensor's room.
 const WINDOW_REACH: f32 = 5.0;
+/// Away from the windows, a patch around the sensors is no wider than this
+/// many times its distance from them ([`PatchSizing`]).
+const SENSOR_SLOPE: f32 = 0.5;
+/// ... and no wider than this many finest sides there.
+const SENSOR_COARSEST: f32 = 2.0;
 
 /// Cells may be this many times finer than `patch_size`, under sensors
 /// close to a surface ([`NearSensor`]).
@@ -180,10 +187,7 @@ impl NearSensor {
         if highest < NEAR_IN_FRONT {
             return None;
         }
-        let (a, b) = (to.dot(square.u), to.dot(square.v));
-        let across = (to - a * square.u - b * square.v).length();
-        let gap = Vec3::new((a.abs() - square.half).max(0.0), (b.abs() - square.half).max(0.0), across).length();
-        Some((NEAR_GROWTH * (gap - self.reach).max(0.0)).max(finest / FINER))
+        Some((NEAR_GROWTH * (square.gap(self.position) - self.reach).max(0.0)).max(finest / FINER))
     }
 }
 
@@ -201,6 +205,14 @@ struct Square {
 impl Square {
     fn point(centre: Vec3) -> Self {
         Square { centre, u: Vec3::X, v: Vec3::Y, half: 0.0 }
+    }
+
+    /// The distance from `p` to the square.
+    fn gap(&self, p: Vec3) -> f32 {
+        let to = self.centre - p;
+        let (a, b) = (to.dot(self.u), to.dot(self.v));
+        let across = (to - a * self.u - b * self.v).length();
+        Vec3::new((a.abs() - self.half).max(0.0), (b.abs() - self.half).max(0.0), across).length()
     }
 }
 
@@ -224,13 +236,22 @@ type Bounds = (Vec3, Vec3);
 /// with one room of sensors does not pay for the rest of it. A scene
 /// without sensors focuses on the box around all its windows (what the
 /// viewer shows lit).
+///
+/// Within the sensors' boxes, away from the windows, a patch may be as
+/// wide as [`SENSOR_SLOPE`] times its distance from the sensors (at most
+/// [`SENSOR_COARSEST`] finest sides): a tall room's ceiling, 2 m and more
+/// above its grid, is seen from every sensor as finely as the desks around
+/// them, in a quarter of the patches.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PatchSizing {
     /// `patch_size`: the side of the finest patches, m.
     pub finest: f32,
-    /// The boxes where patches are finest, margin included; empty: finest
-    /// everywhere.
+    /// The boxes around the sensors, margin included.
     focus: Vec<Bounds>,
+    /// The boxes around the windows that light them (around all the
+    /// windows without sensors), margin included. Both empty: finest
+    /// everywhere.
+    lighting: Vec<Bounds>,
     /// The sensors, by their x, for the patches close to them.
     near: Vec<NearSensor>,
     /// The largest reach of theirs.
@@ -240,7 +261,7 @@ pub struct PatchSizing {
 impl PatchSizing {
     /// Finest everywhere: the uniform `size` grid.
     pub fn uniform(size: f32) -> Self {
-        Self { finest: size, focus: Vec::new(), near: Vec::new(), near_reach: 0.0 }
+        Self { finest: size, focus: Vec::new(), lighting: Vec::new(), near: Vec::new(), near_reach: 0.0 }
     }
 
     /// Finest within [`FOCUS_MARGIN`] of the `sensors` and of the `windows`
@@ -259,21 +280,21 @@ impl PatchSizing {
             let (lo, hi) = cubes.entry(key).or_insert((p, p));
             (*lo, *hi) = (lo.min(p), hi.max(p));
         }
-        let mut focus: Vec<Bounds> = cubes.into_values().collect();
+        let focus: Vec<Bounds> = cubes.into_values().collect();
         let lighting: Vec<Bounds> = if focus.is_empty() {
             windows.iter().copied().reduce(|(lo, hi), (a, b)| (lo.min(a), hi.max(b))).into_iter().collect()
         } else {
             windows.iter().copied().filter(|&w| focus.iter().any(|&s| box_gap(w, s) <= WINDOW_REACH)).collect()
         };
-        focus.extend(lighting);
         let margin = Vec3::splat(FOCUS_MARGIN);
+        let widen = |boxes: Vec<Bounds>| boxes.into_iter().map(|(lo, hi)| (lo - margin, hi + margin)).collect();
         let mut near: Vec<NearSensor> = sensors
             .iter()
             .map(|s| NearSensor { position: s.position, normal: s.normal, reach: s.size.unwrap_or(0.0) * std::f32::consts::FRAC_1_SQRT_2 })
             .collect();
         near.sort_by(|a, b| a.position.x.total_cmp(&b.position.x));
         let near_reach = near.iter().map(|s| s.reach).fold(0.0, f32::max);
-        Self { finest: size, focus: focus.into_iter().map(|(lo, hi)| (lo - margin, hi + margin)).collect(), near, near_reach }
+        Self { finest: size, focus: widen(focus), lighting: widen(lighting), near, near_reach }
     }
 
     /// The sensors that may make patches within `reach` of `centre` finer:
@@ -285,28 +306,38 @@ impl PatchSizing {
         self.near[first..].iter().take_while(move |s| s.position.x <= centre.x + within)
     }
 
-    /// The same sizing for places within `region`: only the focus boxes
-    /// that can be the nearest to some point of it (a large model's
-    /// surfaces each test a few boxes, not all), nearest first.
+    /// The same sizing for places within `region`: only the boxes and the
+    /// sensors that can be the nearest to some point of it (a large model's
+    /// surfaces each test a few, not all), nearest first.
     fn within(&self, region: Bounds) -> Self {
         let reach = 0.5 * (region.1 - region.0).length();
         let centre = 0.5 * (region.0 + region.1);
-        let farthest = self.focus.iter().map(|&b| point_gap(centre, b) + reach).fold(f32::INFINITY, f32::min);
-        let mut focus: Vec<(f32, Bounds)> =
-            self.focus.iter().filter(|&&b| box_gap(region, b) <= farthest).map(|&b| (point_gap(centre, b), b)).collect();
-        // Nearest first: a cell in the focus stops at the first box holding it.
-        focus.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let nearest_first = |boxes: &[Bounds]| {
+            let farthest = boxes.iter().map(|&b| point_gap(centre, b) + reach).fold(f32::INFINITY, f32::min);
+            let mut near: Vec<(f32, Bounds)> =
+                boxes.iter().filter(|&&b| box_gap(region, b) <= farthest).map(|&b| (point_gap(centre, b), b)).collect();
+            // Nearest first: a cell in the focus stops at the first box holding it.
+            near.sort_by(|a, b| a.0.total_cmp(&b.0));
+            near.into_iter().map(|(_, b)| b).collect()
+        };
         let near = self
             .near_sensors(centre, reach)
             .filter(|s| point_gap(s.position, region) <= self.finest / NEAR_GROWTH + s.reach)
             .copied()
             .collect();
-        Self { finest: self.finest, focus: focus.into_iter().map(|(_, b)| b).collect(), near, near_reach: self.near_reach }
+        Self {
+            finest: self.finest,
+            focus: nearest_first(&self.focus),
+            lighting: nearest_first(&self.lighting),
+            near,
+            near_reach: self.near_reach,
+        }
     }
 
     /// The same sizing for places on the plane `normal · p = offset`: without
     /// the sensors it lies behind, parallel to them (the desk a sensor lies
-    /// on, read 1 cm above it; the floor under a grid).
+    /// on, read 1 cm above it; the floor under a grid), for the patches
+    /// close to them.
     fn in_plane(mut self, normal: Vec3, offset: f32) -> Self {
         self.near.retain(|s| {
             let facing = s.normal.dot(normal);
@@ -316,11 +347,12 @@ impl PatchSizing {
     }
 
     /// The numbers the sizing is made of (for cache keys): the finest side,
-    /// every focus box's corners and the sensors patches are finer near.
+    /// every box's corners and the sensors.
     pub fn as_floats(&self) -> Vec<f32> {
-        let corners = self.focus.iter().flat_map(|(lo, hi)| lo.to_array().into_iter().chain(hi.to_array()));
+        let corners = self.focus.iter().chain(&self.lighting).flat_map(|(lo, hi)| lo.to_array().into_iter().chain(hi.to_array()));
         let near = self.near.iter().flat_map(|s| s.position.to_array().into_iter().chain(s.normal.to_array()).chain([s.reach]));
-        std::iter::once(self.finest).chain(corners).chain(near).collect()
+        let counts = [self.focus.len() as f32, self.lighting.len() as f32];
+        std::iter::once(self.finest).chain(counts).chain(corners).chain(near).collect()
     }
 
     /// The share of a patch side's rays that a patch at `centroid` traces:
@@ -339,19 +371,61 @@ impl PatchSizing {
     }
 
     /// The side allowed for `square`, of half-diagonal `reach`: set by its
-    /// nearest point to the focus, and finer where it lies close in front
-    /// of a sensor ([`NearSensor`]).
+    /// nearest point to the windows' and the sensors' boxes, wider with the
+    /// distance from the nearest sensor within theirs, and finer where it
+    /// lies close in front of a sensor ([`NearSensor`]).
     fn allowed_for(&self, square: Square, reach: f32) -> f32 {
         let centre = square.centre;
         let near = self.near_sensors(centre, reach).filter_map(|s| s.allowed(square, self.finest)).fold(self.finest, f32::min);
         if near < self.finest {
             return near;
         }
-        if self.focus.is_empty() {
+        if self.focus.is_empty() && self.lighting.is_empty() {
             return self.finest;
         }
+        let by_windows = self.beyond(&self.lighting, centre, reach);
+        if by_windows <= self.finest {
+            return self.finest;
+        }
+        let by_sensors = self.beyond(&self.focus, centre, reach).max(self.by_slope(square));
+        by_windows.min(by_sensors).max(self.finest)
+    }
+
+    /// The side [`SENSOR_SLOPE`] allows for `square` (a point or a cell),
+    /// at most [`SENSOR_COARSEST`] finest sides, by its distance from the
+    /// sensors' own boxes (a grid's rectangle, the bounds of the others in
+    /// a cube: no farther than the nearest of their sensors, so never
+    /// coarser than the sensors allow). It decides nothing for a cell of
+    /// `finest` or less, or wider than that most, and is not computed for
+    /// them: the quadtree asks of every cell along every triangle's path.
+    fn by_slope(&self, square: Square) -> f32 {
+        let (side, widest) = (2.0 * square.half, SENSOR_COARSEST * self.finest);
+        if square.half > 0.0 && (side <= self.finest || side > widest) {
+            return self.finest;
+        }
+        // A cell is allowed or not; a point's side counts from `finest`.
+        let settled = if square.half > 0.0 { side } else { self.finest };
+        let extent = square.half * (square.u.abs() + square.v.abs());
+        let cell = (square.centre - extent, square.centre + extent);
+        let margin = Vec3::splat(FOCUS_MARGIN);
+        let mut gap = f32::INFINITY;
+        // Nearest first ([`PatchSizing::within`]): one too close settles it.
+        for &(lo, hi) in &self.focus {
+            gap = gap.min(box_gap(cell, (lo + margin, hi - margin)));
+            if SENSOR_SLOPE * gap < settled {
+                return self.finest;
+            }
+        }
+        (SENSOR_SLOPE * gap).min(widest)
+    }
+
+    /// The side `boxes` allow for a cell of half-diagonal `reach` around
+    /// `centre`: `finest` when it meets one, larger by [`GROWTH`] per metre
+    /// beyond the nearest (at most [`COARSEST`] finest sides), unbounded
+    /// without boxes.
+    fn beyond(&self, boxes: &[Bounds], centre: Vec3, reach: f32) -> f32 {
         let mut outside = f32::INFINITY;
-        for &b in &self.focus {
+        for &b in boxes {
             outside = outside.min(point_gap(centre, b));
             if outside <= reach {
                 return self.finest;
@@ -972,6 +1046,46 @@ mod tests {
             let mesh = mesh_of(&[far]);
             assert_eq!(mesh.patches.len(), 8 * 6);
         }
+    }
+
+    /// Away from the windows, a patch may be as wide as half its distance
+    /// from the sensors, at most two finest sides: a tall room's ceiling,
+    /// 2.2 m over its grid, is 1 m patches but where the window's focus
+    /// keeps it finer; 1.7 m over the grid it is the finest grid.
+    #[test]
+    fn a_tall_rooms_ceiling_is_coarser_away_from_its_windows() {
+        let grid: Vec<Sensor> = (0..16)
+            .map(|k| Sensor {
+                name: String::new(),
+                position: Vec3::new(1.0 + 2.0 * (k % 4) as f32, 1.0 + 2.0 * (k / 4) as f32, 0.8),
+                normal: Vec3::Z,
+                size: None,
+                axes: [Vec3::X, Vec3::Y],
+                grid: Some("workplane".into()),
+            })
+            .collect();
+        let window = (Vec3::new(2.0, 0.0, 0.9), Vec3::new(6.0, 0.0, 2.4));
+        let sizing = PatchSizing::around(0.5, &grid, &[window]);
+        // An 8 × 8 m ceiling at `z`, facing down: its patches' (y, area).
+        let patches_at = |z: f32| {
+            let corner = |x: f32, y: f32| Vec3::new(x, y, z);
+            let (a, b, c, d) = (corner(0.0, 0.0), corner(8.0, 0.0), corner(8.0, 8.0), corner(0.0, 8.0));
+            let tris = vec![
+                Triangle { vertices: [a, c, b], material: 0, file_vertices: [0, 2, 1] },
+                Triangle { vertices: [a, d, c], material: 0, file_vertices: [0, 3, 2] },
+            ];
+            let mut surfaces = vec![surface_of(&tris)];
+            let large = LargeFaces::new(&tris, &surfaces, f32::INFINITY);
+            let mesh = subdivide(&tris, &mut surfaces, &sizing, &[false], &[], &large);
+            mesh.patches.iter().map(|p| (p.centroid.y, p.area)).collect::<Vec<_>>()
+        };
+        let tall = patches_at(3.0);
+        assert!(tall.iter().filter(|&&(y, _)| y < 1.5).all(|&(_, area)| (area - 0.25).abs() < 1e-4), "{tall:?}");
+        assert!(tall.iter().filter(|&&(y, _)| y > 4.0).all(|&(_, area)| (area - 1.0).abs() < 1e-4), "{tall:?}");
+        // Finest up to 4 m from the window (its margin and growth), 1 m beyond.
+        assert_eq!(tall.len(), 8 * 16 + 4 * 8);
+        let low = patches_at(2.5);
+        assert_eq!(low.len(), 256);
     }
 
     /// A cell holding a quarter of its area of the surface or more stays a
