@@ -631,7 +631,8 @@ const CLUSTER_LAYER: f32 = 0.1;
 
 /// The clusters of clutter: per surface, its cluster (index into the
 /// returned list of member lists), for the surfaces that `clusterable`
-/// allows, that are small where they lie and that no window plane cuts.
+/// allows, that are small where they lie and that no window plane or large
+/// face (`contacts`) cuts.
 /// Clutter on the two sides of a window's plane (frames outside and in),
 /// or of a large face crossing its cube (a door's handles outside and in,
 /// [`LargeFaces::separating`]), never shares a cluster.
@@ -642,6 +643,7 @@ fn clusters(
     clusterable: &[bool],
     cuts: &[CutPlane],
     large: &LargeFaces,
+    contacts: &[Vec<CutPlane>],
 ) -> (Vec<Option<u32>>, Vec<Vec<u32>>) {
     type Key = (u32, u8, [i64; 3], i64, Vec<(u32, bool)>, Vec<bool>);
     let mut keys: BTreeMap<Key, u32> = BTreeMap::new();
@@ -653,7 +655,10 @@ fn clusters(
         let tris = &triangles[surface.triangles.start as usize..surface.triangles.end as usize];
         let centroid = tris.iter().map(|t| t.centroid() * t.area()).sum::<Vec3>() / surface.area.max(f32::MIN_POSITIVE);
         let allowed = sizing.allowed(centroid, 0.0);
-        if !clusterable[index] || surface.area >= CLUTTER * allowed * allowed {
+        // Clutter a large face runs through (a rafter or a beam through a
+        // wall, out to the eaves) is cut there as a surface: clustered
+        // whole, its sunlit end outside lit the room inside.
+        if !clusterable[index] || surface.area >= CLUTTER * allowed * allowed || !contacts[index].is_empty() {
             continue;
         }
         let bounds = super::bounds(tris);
@@ -698,7 +703,7 @@ pub fn subdivide(
 ) -> PatchMesh {
     let mut mesh = PatchMesh::default();
     let contacts = contact_cuts(large, surfaces);
-    let (cluster_of, members) = clusters(triangles, surfaces, sizing, clusterable, cuts, large);
+    let (cluster_of, members) = clusters(triangles, surfaces, sizing, clusterable, cuts, large, &contacts);
     // Each surface's patches, surface by surface on every core.
     let shared: &[Surface] = surfaces;
     let surface_patches = par_map(None, shared.len(), |index| match cluster_of[index] {
