@@ -29,8 +29,10 @@ const MAX_CUTS: usize = 64;
 const CELL: f32 = 1.0;
 /// Faces spanning more cells than this are checked against every surface.
 const MAX_CELLS: i64 = 4096;
-/// Contacts shorter than this (m) are points, not lines.
+/// Contacts shorter than this (m) in all, per plane, are points, not lines.
 const MIN_CONTACT: f32 = 0.01;
+/// One face's piece of a contact shorter than this (m) is a point.
+const MIN_PIECE: f32 = 1e-4;
 /// A contact cuts the pieces within this distance of it, m.
 const CONTACT_REACH: f32 = 0.01;
 /// A face whose edge comes this close to a surface (m) meets it: a door leaf
@@ -189,6 +191,10 @@ pub fn contact_cuts(large: &LargeFaces, surfaces: &[Surface]) -> Vec<Vec<CutPlan
                 None => cuts.push((cut, length)),
             }
         }
+        // A plane's contacts count together: a gable fanned from its apex
+        // round a window meets a beam through it in slivers of a few
+        // millimetres each.
+        cuts.retain(|(_, total)| *total >= MIN_CONTACT);
         cuts.sort_by(|a, b| b.1.total_cmp(&a.1));
         cuts.into_iter().take(MAX_CUTS).map(|(c, _)| c).collect()
     })
@@ -235,13 +241,13 @@ impl Flat {
             .iter()
             .flat_map(|&p| points.iter().map(move |&q| (p, q)))
             .max_by(|a, b| a.0.distance_squared(a.1).total_cmp(&b.0.distance_squared(b.1)))?;
-        if p.distance(q) < MIN_CONTACT {
+        if p.distance(q) < MIN_PIECE {
             return None;
         }
         // The part of the line inside the surface: a wall's face crossing a
         // rafter or a beam that runs through it meets the rafter's plane
         // along the whole wall, the rafter for a hand's width of it.
-        if let Some((a, b)) = self.part_inside(p, q).filter(|(a, b)| a.distance(*b) >= MIN_CONTACT) {
+        if let Some((a, b)) = self.part_inside(p, q).filter(|(a, b)| a.distance(*b) >= MIN_PIECE) {
             return Some((a, b));
         }
         // A line along an edge between two of the surface's own triangles
@@ -447,6 +453,20 @@ mod tests {
         assert!(cut.normal.y.abs() > 0.999 && cut.offset.abs() < 1e-6, "{cut:?}");
         assert!(cut.near.0.x > 5.2 && cut.near.1.x < 5.5, "the part inside the rafter: {cut:?}");
         assert!(cuts[3].is_empty(), "{:?}", cuts[3]);
+
+        // A gable fanned from its apex meets a ridge beam through it in
+        // slivers a millimetre wide each: together they cut it.
+        let apex = Vec3::new(0.0, 5.0, 6.0);
+        let fan: Vec<Triangle> = (0..100)
+            .map(|k| {
+                let at = |k: i32| Vec3::new(0.0, 4.0 + 0.02 * k as f32, 4.0);
+                Triangle { vertices: [apex, at(k + 1), at(k)], material: 0, file_vertices: [0, 1, 2] }
+            })
+            .collect();
+        let beam = quad(1, [[-0.5, 4.96, 5.9], [-0.5, 5.04, 5.9], [12.0, 5.04, 5.9], [12.0, 4.96, 5.9]]);
+        let (triangles, surfaces) = self::surfaces(&[fan, beam]);
+        let cuts = contact_cuts(&LargeFaces::new(&triangles, &surfaces, 1.0), &surfaces);
+        assert!(cuts[1].iter().any(|c| c.normal.x.abs() > 0.999 && c.offset.abs() < 1e-6), "{:?}", cuts[1]);
     }
 
     /// A door leaf 4 mm over its threshold parts the light on it as a wall
