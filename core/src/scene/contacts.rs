@@ -168,15 +168,16 @@ pub fn contact_cuts(large: &LargeFaces, surfaces: &[Surface]) -> Vec<Vec<CutPlan
             if own.contains(&(t as usize)) {
                 continue;
             }
+            let Some((p, q)) = flat.contact(face) else { continue };
             let normal = face.normal();
             // A cut must leave more than a sliver on either side (a chair's
-            // leg sunk a millimetre into the floor is not cut).
+            // leg sunk a millimetre into the floor is not cut): tested after
+            // `contact`, which turns most faces away from their corners alone.
             let heights = tris.iter().flat_map(|t| t.vertices).map(|v| normal.dot(v - face.vertices[0]));
             let (below, above) = heights.fold((0.0f32, 0.0f32), |(lo, hi), h| (lo.min(h), hi.max(h)));
             if below > -CONTACT_GAP || above < CONTACT_GAP {
                 continue;
             }
-            let Some((p, q)) = flat.contact(face) else { continue };
             let cut = CutPlane {
                 normal,
                 offset: normal.dot(face.vertices[0]),

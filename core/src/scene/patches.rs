@@ -8,8 +8,8 @@
 //! sensors), and growing with the distance from it (a quarter of that
 //! distance, at most 64 × `patch_size`); away from the windows, patches
 //! may be as wide as half their distance from the sensors, at most twice
-//! `patch_size` (a tall room's ceiling over its grid). So a room keeps today's grid,
-//! while the far ground, the site's context, the outside of the building
+//! `patch_size` (a tall room's ceiling over its grid). So a room keeps
+//! today's grid, while the far ground, the site's context, the outside of the building
 //! far from its windows and the wings and storeys where no sensor reads
 //! get a few large patches. A patch is one leaf cell's part of the surface;
 //! the pieces of triangles inside the cell are its render triangles.
@@ -187,7 +187,10 @@ impl NearSensor {
         if highest < NEAR_IN_FRONT {
             return None;
         }
-        Some((NEAR_GROWTH * (square.gap(self.position) - self.reach).max(0.0)).max(finest / FINER))
+        let (a, b) = (to.dot(square.u), to.dot(square.v));
+        let across = (to - a * square.u - b * square.v).length();
+        let gap = Vec3::new((a.abs() - square.half).max(0.0), (b.abs() - square.half).max(0.0), across).length();
+        Some((NEAR_GROWTH * (gap - self.reach).max(0.0)).max(finest / FINER))
     }
 }
 
@@ -205,14 +208,6 @@ struct Square {
 impl Square {
     fn point(centre: Vec3) -> Self {
         Square { centre, u: Vec3::X, v: Vec3::Y, half: 0.0 }
-    }
-
-    /// The distance from `p` to the square.
-    fn gap(&self, p: Vec3) -> f32 {
-        let to = self.centre - p;
-        let (a, b) = (to.dot(self.u), to.dot(self.v));
-        let across = (to - a * self.u - b * self.v).length();
-        Vec3::new((a.abs() - self.half).max(0.0), (b.abs() - self.half).max(0.0), across).length()
     }
 }
 
@@ -306,9 +301,9 @@ impl PatchSizing {
         self.near[first..].iter().take_while(move |s| s.position.x <= centre.x + within)
     }
 
-    /// The same sizing for places within `region`: only the boxes and the
-    /// sensors that can be the nearest to some point of it (a large model's
-    /// surfaces each test a few, not all), nearest first.
+    /// The same sizing for places within `region`: only the boxes that can
+    /// be the nearest to some point of it (a large model's surfaces each
+    /// test a few, not all), nearest first.
     fn within(&self, region: Bounds) -> Self {
         let reach = 0.5 * (region.1 - region.0).length();
         let centre = 0.5 * (region.0 + region.1);
@@ -371,9 +366,9 @@ impl PatchSizing {
     }
 
     /// The side allowed for `square`, of half-diagonal `reach`: set by its
-    /// nearest point to the windows' and the sensors' boxes, wider with the
-    /// distance from the nearest sensor within theirs, and finer where it
-    /// lies close in front of a sensor ([`NearSensor`]).
+    /// nearest point to the windows' and the sensors' boxes, wider with its
+    /// distance from the sensors within theirs ([`Self::by_slope`]), and
+    /// finer where it lies close in front of a sensor ([`NearSensor`]).
     fn allowed_for(&self, square: Square, reach: f32) -> f32 {
         let centre = square.centre;
         let near = self.near_sensors(centre, reach).filter_map(|s| s.allowed(square, self.finest)).fold(self.finest, f32::min);
