@@ -1141,6 +1141,11 @@ fn interior_glazing_is_enclosed_and_a_facade_window_faces_out() {
     // A glass partition across the room, 3 m in.
     let mut obj = std::fs::read_to_string(path.with_file_name("room.obj")).unwrap();
     obj.push_str("usemtl glass\nv 0.5 3 0.5\nv 3.5 3 0.5\nv 3.5 3 2.5\nv 0.5 3 2.5\nf -4 -3 -2 -1\n");
+    // Glazing bars crossing at the façade window's centre (x 2, z 1.6),
+    // through its pane (y −0.2): the centre itself sees no sky either way.
+    for (lo, hi) in [([1.987, -0.213, 0.9], [2.013, -0.187, 2.3]), ([1.0, -0.213, 1.587], [3.0, -0.187, 1.613])] {
+        obj.push_str(&box_obj("wall", lo, hi));
+    }
     std::fs::write(path.with_file_name("room.obj"), obj).unwrap();
     let scene = load(&path);
     let model = LightModel::unlit(scene.clone());
@@ -1153,6 +1158,23 @@ fn interior_glazing_is_enclosed_and_a_facade_window_faces_out() {
             assert!(group.outward.y < -0.99, "the façade window faces south: {}", group.outward);
         }
     }
+}
+
+/// OBJ text for the closed box between corners `lo` and `hi` (relative
+/// indices: it may be appended to any model).
+fn box_obj(material: &str, lo: [f64; 3], hi: [f64; 3]) -> String {
+    let corner =
+        |i: usize| [if i & 1 == 0 { lo[0] } else { hi[0] }, if i & 2 == 0 { lo[1] } else { hi[1] }, if i & 4 == 0 { lo[2] } else { hi[2] }];
+    let faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let mut text = format!("usemtl {material}\n");
+    for face in faces {
+        for i in face {
+            let [x, y, z] = corner(i);
+            text.push_str(&format!("v {x} {y} {z}\n"));
+        }
+        text.push_str("f -4 -3 -2 -1\n");
+    }
+    text
 }
 
 /// No light leaks under a wall: a windowless room whose floor runs on

@@ -8,7 +8,7 @@
 use glam::DVec3;
 
 use super::bvh::Tracer;
-use super::sampling::{Rng, cosine_directions};
+use super::sampling::{Rng, cosine_directions, stratified_area_points, with_cumulative_areas};
 use crate::scene::{Scene, Window};
 
 /// Rays per hemisphere that decide which side of a window is outside.
@@ -48,7 +48,7 @@ impl WindowGroups {
     pub(super) fn new(scene: &Scene, tracer: &Tracer) -> Self {
         let mut out = Self::default();
         for (index, window) in scene.windows.iter().enumerate() {
-            let (outward, enclosed) = outward_normal(tracer, window);
+            let (outward, enclosed) = outward_normal(scene, tracer, window);
             let same =
                 |g: &WindowGroup| g.material == window.material && g.enclosed == enclosed && g.outward.dot(outward) > 1.0 - SAME_FACING;
             let group = match out.groups.iter().position(same) {
@@ -68,13 +68,18 @@ impl WindowGroups {
 
 /// The normal of `window` turned toward the outside: the side from which
 /// more of the sky is seen (on a tie, against the polygon's normal); and
-/// whether neither side sees any.
-fn outward_normal(tracer: &Tracer, window: &Window) -> (DVec3, bool) {
+/// whether neither side sees any. The rays leave from points spread over
+/// the pane, not its centre alone: a window of four lights has its
+/// glazing bars crossing there.
+fn outward_normal(scene: &Scene, tracer: &Tracer, window: &Window) -> (DVec3, bool) {
     let normal = window.normal.as_dvec3();
-    let centre = window.centroid.as_dvec3();
+    let range = scene.surfaces[window.surface as usize].triangles.clone();
+    let triangles = with_cumulative_areas(scene.triangles[range.start as usize..range.end as usize].iter().map(|t| t.vertices));
     let mut rng = Rng::new(5, u64::from(window.surface));
     let open = |side: DVec3, rng: &mut Rng| {
-        cosine_directions(side, SIDE_RAYS, rng).into_iter().filter(|&d| tracer.closest(centre + side * 1e-3, d, 1e-6).is_none()).count()
+        let points: Vec<DVec3> = stratified_area_points(&triangles, SIDE_RAYS, rng).collect();
+        let directions = cosine_directions(side, SIDE_RAYS, rng);
+        points.into_iter().zip(directions).filter(|&(p, d)| tracer.closest(p + side * 1e-3, d, 1e-6).is_none()).count()
     };
     let along = open(normal, &mut rng);
     let against = open(-normal, &mut rng);
