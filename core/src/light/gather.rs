@@ -427,7 +427,7 @@ impl LightModel {
     ) -> Result<Self, String> {
         check_memory(&scene, &settings)?;
         let lent = beside.is_some_and(|b| Arc::ptr_eq(&b.scene, &scene) && b.tracer.get().is_some());
-        let ((empty, dark), tracer) = par_join(
+        let ((empty, mut dark), tracer) = par_join(
             settings.threads,
             || (Self::empty(scene.clone(), settings, beside, None), super::solids::dark_sides(&scene)),
             || (!lent).then(|| Arc::new(Tracer::new(&scene.patches))),
@@ -435,6 +435,7 @@ impl LightModel {
         if let Some(tracer) = tracer {
             let _ = empty.tracer.set(tracer);
         }
+        super::solids::slot_sides(&scene, empty.tracer(), &mut dark, settings.threads);
         Ok(empty.gathered(&dark, beside, progress))
     }
 
