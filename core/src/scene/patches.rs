@@ -299,7 +299,9 @@ impl PatchSizing {
     /// points make one box (a grid is a rectangle), other sensors one per
     /// [`SENSOR_CUBE`] they occupy.
     pub fn around(size: f32, sensors: &[Sensor], windows: &[Bounds]) -> Self {
-        let mut cubes: BTreeMap<(Option<&str>, [i32; 3]), (Bounds, Option<ReadingPlane>)> = BTreeMap::new();
+        // Per grid, or per cube other sensors occupy: their bounds and shared plane.
+        type Key<'a> = (Option<&'a str>, [i32; 3]);
+        let mut cubes: BTreeMap<Key, (Bounds, Option<ReadingPlane>)> = BTreeMap::new();
         for sensor in sensors {
             let p = sensor.position;
             let key = match &sensor.grid {
