@@ -57,19 +57,31 @@ fn test_room_loads_with_its_six_windows() {
     assert!((opaque - (108.0 - 4.59)).abs() < 1e-3, "{opaque}");
     // Patches cover every surface exactly and are no larger than a grid cell
     // and a half (a sliver along a wall's edge joins the cell beside it), but
-    // for the ceiling's 1 m cells, 2.2 m over the grid and 4 m from the
-    // windows and more.
+    // for 1 m cells 4 m from the windows and more: the ceiling's, 2.2 m over
+    // the grid, and the floor's, behind it.
     let patch_area: f32 = scene.patches.patches.iter().map(|p| p.area).sum();
     let surface_area: f32 = scene.surfaces.iter().map(|s| s.area).sum();
     assert!((patch_area - surface_area).abs() < 1e-3);
-    let ceiling = scene.materials.iter().position(|m| m.name == "ceiling").unwrap() as u32;
+    let material = |name: &str| scene.materials.iter().position(|m| m.name == name).unwrap() as u32;
+    let (ceiling, floor) = (material("ceiling"), material("floor"));
     let wide = |p: &&heliodon_core::scene::Patch| p.area > 1.5 * 0.25 + 1e-5;
-    assert!(scene.patches.patches.iter().filter(wide).all(|p| p.material == ceiling && p.centroid.y > 4.0 && p.area <= 1.0 + 1e-5));
-    assert!(scene.patches.patches.iter().any(|p| wide(&p)), "the ceiling's back is coarser");
+    assert!(
+        scene
+            .patches
+            .patches
+            .iter()
+            .filter(wide)
+            .all(|p| [ceiling, floor].contains(&p.material) && p.centroid.y > 4.0 && p.area <= 1.0 + 1e-5)
+    );
+    for coarser in [ceiling, floor] {
+        assert!(scene.patches.patches.iter().any(|p| p.material == coarser && wide(&p)), "the ceiling's and the floor's backs are coarser");
+    }
     assert!(scene.patches.patches.iter().filter(|p| p.area > 0.25 + 1e-5).count() > 0, "slivers joined the cells beside them");
-    // The floor (4 × 6 m) alone is 96 patches of 0.5 m.
-    let floor = scene.materials.iter().position(|m| m.name == "floor").unwrap() as u32;
-    assert_eq!(scene.patches.patches.iter().filter(|p| p.material == floor).count(), 96);
+    // The floor (4 × 6 m) is 0.5 m patches but for two 1 m cells in its back
+    // corners: 4 m and more from the windows, behind the desks' sensors, and
+    // 2 m and more from the sensor on the back wall, which sees the rest.
+    let floor_patches: Vec<_> = scene.patches.patches.iter().filter(|p| p.material == floor).map(|p| (p.centroid, p.area)).collect();
+    assert_eq!(floor_patches.len(), 96 - 2 * 4 + 2, "{floor_patches:?}");
 }
 
 #[test]
