@@ -343,7 +343,9 @@ impl PatchSizing {
 
     /// The same sizing for places within `region`: only the boxes that can
     /// be the nearest to some point of it (a large model's surfaces each
-    /// test a few, not all), nearest first.
+    /// test a few, not all), and the sensors' boxes within the slope's reach
+    /// of it (the nearest may not see a place, [`ReadingPlane`]), nearest
+    /// first.
     fn within(&self, region: Bounds) -> Self {
         let reach = 0.5 * (region.1 - region.0).length();
         let centre = 0.5 * (region.0 + region.1);
