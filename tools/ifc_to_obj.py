@@ -18,13 +18,16 @@ plane of most area (the wall's opening has its own reveals). Each IfcSpace gets 
 above its floor on a --spacing grid, 0.3 m in from the walls of its box,
 named after the space (its LongName; see `space_names` where long names repeat):
 a sensor grid where the space fills its box, otherwise the grid's points
-over the space's floor as point sensors `<space>/<k>` (an L-shaped
-corridor's box reaches into the rooms beside it). The site's latitude and
+over the space's floor, 0.3 m in from its edges too, as point sensors
+`<space>/<k>` (an L-shaped corridor's box reaches into the rooms beside it;
+a point 2 cm from a wall in the notch of such a space sees that wall as half
+its view, and refines the wall's patches around it to a few centimetres). The site's latitude and
 longitude come from IfcSite when given there, and without --timezone the
 standard time is that of the meridian nearest the longitude (said so: an
 IFC site names no time zone, and UTC at Chicago puts noon at 6 a.m.).
 """
 import argparse
+import math
 import os
 import re
 import sys
@@ -141,6 +144,14 @@ def over_floor(point, floor):
     return False
 
 
+def inside_floor(point, floor, inset):
+    """Whether (x, y) lies over the floor and `inset` in from its edges: the
+    point and eight points that far around it over its triangles."""
+    x, y = point
+    around = [(x + inset * math.cos(k * math.pi / 4), y + inset * math.sin(k * math.pi / 4)) for k in range(8)]
+    return all(over_floor(p, floor) for p in [point] + around)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("ifc")
@@ -254,7 +265,7 @@ def main():
                         f'max = [{x1:.3f}, {y1:.3f}]\nheight = {height:.3f}\nspacing = {a.spacing}\n')
                 continue
             partial += 1
-            for k in inside:
+            for k in [k for k in inside if inside_floor(points[k], floor, 0.3)]:
                 x, y = points[k]
                 f.write(f'\n[[sensors]]\nname = "{name}/{k}"\nposition = [{x:.3f}, {y:.3f}, {height:.3f}]\nnormal = [0.0, 0.0, 1.0]\n')
     for kind, count in sorted(skipped.items()):
