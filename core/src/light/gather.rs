@@ -435,7 +435,7 @@ impl LightModel {
         if let Some(tracer) = tracer {
             let _ = empty.tracer.set(tracer);
         }
-        super::solids::slot_sides(&scene, empty.tracer(), &mut dark, settings.threads);
+        super::solids::slot_sides(&empty, &mut dark);
         Ok(empty.gathered(&dark, beside, progress))
     }
 

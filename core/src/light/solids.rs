@@ -23,9 +23,8 @@
 
 use glam::DVec3;
 
-use super::bvh::Tracer;
-use super::sampling::{Rng, stratified_area_points, with_cumulative_areas};
-use super::side_of;
+use super::sampling::{Rng, stratified_area_points};
+use super::{LightModel, Surface, side_of};
 use crate::parallel::par_map;
 use crate::scene::shells::{Shells, model_shells, winding_number};
 use crate::scene::{MaterialKind, Scene};
@@ -92,27 +91,23 @@ const SLOT_WIDTH: f64 = 0.005;
 /// Points of a side probed for a slot, spread over it.
 const SLOT_PROBES: usize = 9;
 
-/// Marks in `dark` the sides of opaque patches that look into a slot: from
-/// each of [`SLOT_PROBES`] points spread over the side, the ray along its
-/// normal meets an opaque face within [`SLOT_WIDTH`].
-pub(super) fn slot_sides(scene: &Scene, tracer: &Tracer, dark: &mut [bool], threads: Option<usize>) {
-    let opaque = |patch: u32| {
-        let patch = &scene.patches.patches[patch as usize];
-        matches!(scene.materials[patch.material as usize].kind, MaterialKind::Diffuse { .. })
-    };
-    let mesh = &scene.patches;
-    let in_slot = par_map(threads, mesh.patches.len() * 2, |side| {
+/// Marks in `dark` the sides of `model`'s opaque patches that look into a
+/// slot: from each of [`SLOT_PROBES`] points spread over the side, the ray
+/// along its normal meets an opaque face within [`SLOT_WIDTH`].
+pub(super) fn slot_sides(model: &LightModel, dark: &mut [bool]) {
+    let opaque = |patch: u32| matches!(model.surface_of_patch(patch), Surface::Diffuse(_));
+    let in_slot = par_map(model.settings.threads, dark.len(), |side| {
         let patch = (side / 2) as u32;
         if dark[side] || !opaque(patch) {
             return false;
         }
-        let range = mesh.patches[patch as usize].triangles.clone();
-        let triangles = with_cumulative_areas(mesh.triangles[range.start as usize..range.end as usize].iter().copied());
-        let normal = mesh.patches[patch as usize].normal.as_dvec3() * if side % 2 == 1 { -1.0 } else { 1.0 };
+        let triangles = model.patch_triangles(patch as usize);
+        let normal = model.patch_normal(patch) * if side % 2 == 1 { -1.0 } else { 1.0 };
         let mut rng = Rng::new(7, side as u64);
         let mut points = stratified_area_points(&triangles, SLOT_PROBES, &mut rng);
         points.all(|point| {
-            tracer
+            model
+                .tracer()
                 .closest(point + normal * super::SURFACE_OFFSET, normal, 1e-6)
                 .is_some_and(|hit| hit.distance < SLOT_WIDTH && opaque(hit.patch))
         })
@@ -258,7 +253,7 @@ mod tests {
             }
             let scene = scene_of(&format!("solids-slot-{gap}"), &obj, "");
             let mut dark = dark_sides(&scene);
-            slot_sides(&scene, &Tracer::new(&scene.patches), &mut dark, None);
+            slot_sides(&LightModel::unlit(std::sync::Arc::new(scene.clone())), &mut dark);
             // Per patch: its normal's x, and whether its front is dark.
             (0..scene.patches.patches.len() as u32)
                 .map(|p| {

@@ -1100,43 +1100,55 @@ mod tests {
         assert_eq!(mesh_of(&[sensor(0.0, Vec3::NEG_Y)]).patches.len(), 4 * 3, "behind it");
     }
 
+    /// Sensor `k` of a 4 × 4 grid, 2 m apart, 0.8 m over an 8 × 8 m room.
+    fn desk_sensor(k: usize, normal: Vec3, grid: &str) -> Sensor {
+        Sensor {
+            name: String::new(),
+            position: Vec3::new(1.0 + 2.0 * (k % 4) as f32, 1.0 + 2.0 * (k / 4) as f32, 0.8),
+            normal,
+            size: None,
+            axes: [Vec3::X, Vec3::Y],
+            grid: Some(grid.into()),
+        }
+    }
+
+    /// The (centroid y, area) of each patch `sizing` cuts an 8 × 8 m
+    /// horizontal square at `z` into, facing up or down.
+    fn square_patches(z: f32, up: bool, sizing: &PatchSizing) -> Vec<(f32, f32)> {
+        let corner = |x: f32, y: f32| Vec3::new(x, y, z);
+        let (a, b, c, d) = (corner(0.0, 0.0), corner(8.0, 0.0), corner(8.0, 8.0), corner(0.0, 8.0));
+        let tris = if up {
+            vec![
+                Triangle { vertices: [a, b, c], material: 0, file_vertices: [0, 1, 2] },
+                Triangle { vertices: [a, c, d], material: 0, file_vertices: [0, 2, 3] },
+            ]
+        } else {
+            vec![
+                Triangle { vertices: [a, c, b], material: 0, file_vertices: [0, 2, 1] },
+                Triangle { vertices: [a, d, c], material: 0, file_vertices: [0, 3, 2] },
+            ]
+        };
+        let mut surfaces = vec![surface_of(&tris)];
+        let large = LargeFaces::new(&tris, &surfaces, f32::INFINITY);
+        let mesh = subdivide(&tris, &mut surfaces, sizing, &[false], &[], &large);
+        mesh.patches.iter().map(|p| (p.centroid.y, p.area)).collect()
+    }
+
     /// Away from the windows, a patch may be as wide as half its distance
     /// from the sensors, at most two finest sides: a tall room's ceiling,
     /// 2.2 m over its grid, is 1 m patches but where the window's focus
     /// keeps it finer; 1.7 m over the grid it is the finest grid.
     #[test]
     fn a_tall_rooms_ceiling_is_coarser_away_from_its_windows() {
-        let grid: Vec<Sensor> = (0..16)
-            .map(|k| Sensor {
-                name: String::new(),
-                position: Vec3::new(1.0 + 2.0 * (k % 4) as f32, 1.0 + 2.0 * (k / 4) as f32, 0.8),
-                normal: Vec3::Z,
-                size: None,
-                axes: [Vec3::X, Vec3::Y],
-                grid: Some("workplane".into()),
-            })
-            .collect();
+        let grid: Vec<Sensor> = (0..16).map(|k| desk_sensor(k, Vec3::Z, "workplane")).collect();
         let window = (Vec3::new(2.0, 0.0, 0.9), Vec3::new(6.0, 0.0, 2.4));
         let sizing = PatchSizing::around(0.5, &grid, &[window]);
-        // An 8 × 8 m ceiling at `z`, facing down: its patches' (y, area).
-        let patches_at = |z: f32| {
-            let corner = |x: f32, y: f32| Vec3::new(x, y, z);
-            let (a, b, c, d) = (corner(0.0, 0.0), corner(8.0, 0.0), corner(8.0, 8.0), corner(0.0, 8.0));
-            let tris = vec![
-                Triangle { vertices: [a, c, b], material: 0, file_vertices: [0, 2, 1] },
-                Triangle { vertices: [a, d, c], material: 0, file_vertices: [0, 3, 2] },
-            ];
-            let mut surfaces = vec![surface_of(&tris)];
-            let large = LargeFaces::new(&tris, &surfaces, f32::INFINITY);
-            let mesh = subdivide(&tris, &mut surfaces, &sizing, &[false], &[], &large);
-            mesh.patches.iter().map(|p| (p.centroid.y, p.area)).collect::<Vec<_>>()
-        };
-        let tall = patches_at(3.0);
+        let tall = square_patches(3.0, false, &sizing);
         assert!(tall.iter().filter(|&&(y, _)| y < 1.5).all(|&(_, area)| (area - 0.25).abs() < 1e-4), "{tall:?}");
         assert!(tall.iter().filter(|&&(y, _)| y > 4.0).all(|&(_, area)| (area - 1.0).abs() < 1e-4), "{tall:?}");
         // Finest up to 4 m from the window (its margin and growth), 1 m beyond.
         assert_eq!(tall.len(), 8 * 16 + 4 * 8);
-        let low = patches_at(2.5);
+        let low = square_patches(2.5, false, &sizing);
         assert_eq!(low.len(), 256);
     }
 
@@ -1145,34 +1157,16 @@ mod tests {
     /// and keep it finest.
     #[test]
     fn the_floor_under_a_grid_is_coarser_away_from_its_window() {
-        let sensor = |k: usize, normal: Vec3, grid: Option<&str>| Sensor {
-            name: String::new(),
-            position: Vec3::new(1.0 + 2.0 * (k % 4) as f32, 1.0 + 2.0 * (k / 4) as f32, 0.8),
-            normal,
-            size: None,
-            axes: [Vec3::X, Vec3::Y],
-            grid: grid.map(String::from),
-        };
         let window = (Vec3::new(2.0, 0.0, 0.9), Vec3::new(6.0, 0.0, 2.4));
-        let floor_areas = |sensors: &[Sensor]| {
-            let corner = |x: f32, y: f32| Vec3::new(x, y, 0.0);
-            let (a, b, c, d) = (corner(0.0, 0.0), corner(8.0, 0.0), corner(8.0, 8.0), corner(0.0, 8.0));
-            let tris = vec![
-                Triangle { vertices: [a, b, c], material: 0, file_vertices: [0, 1, 2] },
-                Triangle { vertices: [a, c, d], material: 0, file_vertices: [0, 2, 3] },
-            ];
-            let mut surfaces = vec![surface_of(&tris)];
-            let large = LargeFaces::new(&tris, &surfaces, f32::INFINITY);
-            let mesh = subdivide(&tris, &mut surfaces, &PatchSizing::around(0.5, sensors, &[window]), &[false], &[], &large);
-            mesh.patches.iter().map(|p| (p.centroid.y, p.area)).collect::<Vec<_>>()
+        let floor_of = |normal: Vec3| {
+            let sensors: Vec<Sensor> = (0..16).map(|k| desk_sensor(k, normal, "desks")).collect();
+            square_patches(0.0, true, &PatchSizing::around(0.5, &sensors, &[window]))
         };
-        let desks: Vec<Sensor> = (0..16).map(|k| sensor(k, Vec3::Z, Some("desks"))).collect();
-        let under_desks = floor_areas(&desks);
+        let under_desks = floor_of(Vec3::Z);
         assert!(under_desks.iter().filter(|&&(y, _)| y < 1.5).all(|&(_, area)| (area - 0.25).abs() < 1e-4), "{under_desks:?}");
         assert!(under_desks.iter().filter(|&&(y, _)| y > 5.0).all(|&(_, area)| (area - 1.0).abs() < 1e-4), "{under_desks:?}");
         // Facing down, the floor is in their view.
-        let facing_down: Vec<Sensor> = (0..16).map(|k| sensor(k, Vec3::NEG_Z, Some("down"))).collect();
-        let seen = floor_areas(&facing_down);
+        let seen = floor_of(Vec3::NEG_Z);
         assert!(seen.iter().all(|&(_, area)| (area - 0.25).abs() < 1e-4), "{seen:?}");
     }
 
