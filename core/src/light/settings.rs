@@ -32,10 +32,11 @@ pub struct LightSettings {
     /// relight.
     pub sky_rays_per_sensor: usize,
     /// The share of the patch rays (hemisphere and aimed) at most that a
-    /// side no sensor sees traces, where a scene has sensors (farther from
-    /// them, the sizing's smaller share: `PatchSizing::ray_share`), and
-    /// this share again for each bounce farther its light is from the
-    /// sensors (up to three: a sixty-fourth). Such a side reaches the
+    /// side no sensor sees traces per bounce its light is from the sensors,
+    /// where a scene has sensors (farther from them, the sizing's smaller
+    /// share: `PatchSizing::ray_share`): one bounce away twice this share
+    /// (`gather.rs`'s `ONE_BOUNCE_FACTOR`), then this share again for each
+    /// bounce farther (up to three: a sixty-fourth). Such a side reaches the
     /// sensors only after one more bounce (or more), where its noise
     /// averages over the many sides each seen side gathers from. At a
     /// quarter, AC20-Institute-Var-2 with one office's sensors precomputes
