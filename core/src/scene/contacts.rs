@@ -293,7 +293,7 @@ impl Flat {
         let (start, along) = (flat(p), flat(q) - flat(p));
         let segment = (start.min(start + along), start.max(start + along));
         let mut span: Option<(f32, f32)> = None;
-        for (&[a, b, c], _) in self.triangles.iter().zip(&self.boxes).filter(|(_, bounds)| boxes_meet(segment, **bounds)) {
+        for [a, b, c] in self.triangles_meeting(segment) {
             let turn = (b - a).perp_dot(c - a);
             if turn.abs() < 1e-12 {
                 continue;
@@ -322,10 +322,16 @@ impl Flat {
         span.map(|(lo, hi)| (p.lerp(q, lo), p.lerp(q, hi)))
     }
 
+    /// The triangles whose boxes come within [`BOX_MARGIN`] of the box
+    /// `bounds` (in the plane's coordinates).
+    fn triangles_meeting(&self, bounds: (Vec2, Vec2)) -> impl Iterator<Item = [Vec2; 3]> + '_ {
+        self.triangles.iter().zip(&self.boxes).filter(move |(_, b)| boxes_meet(bounds, **b)).map(|(t, _)| *t)
+    }
+
     /// Whether `point` (near the plane) lies inside one of the triangles.
     fn holds(&self, point: Vec3) -> bool {
         let x = Vec2::new(point.dot(self.u), point.dot(self.v));
-        self.triangles.iter().zip(&self.boxes).filter(|(_, bounds)| boxes_meet((x, x), **bounds)).any(|(&[a, b, c], _)| {
+        self.triangles_meeting((x, x)).any(|[a, b, c]| {
             let d = (b - a).perp_dot(c - a);
             if d.abs() < 1e-12 {
                 return false;
