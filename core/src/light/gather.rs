@@ -98,8 +98,7 @@ impl Sight {
     const FARTHER: Sight = Sight(3);
 
     /// The share of its rays a side traces: all when seen, and more where
-    /// it fills much of a sensor's `view` ([`rays_for_view`]) or is `wide`
-    /// and in view ([`rays_for_width`]); else the
+    /// it fills much of a sensor's `view` ([`rays_for_view`]); else the
     /// `unseen` share once per bounce farther from the sensors (twice that
     /// one bounce away, [`ONE_BOUNCE_FACTOR`]), and no more than the share
     /// `where_it_lies` ([`crate::scene::PatchSizing::ray_share`]); an unseen
@@ -108,7 +107,7 @@ impl Sight {
     /// no less than the farthest sides do.
     fn ray_share(self, where_it_lies: f64, unseen: f64, view: f64, wide: f64) -> f64 {
         match self {
-            Sight::SEEN => rays_for_view(view).max(rays_for_width(wide, view)),
+            Sight::SEEN => rays_for_view(view),
             Sight(steps) => {
                 let nearer = if steps == 1 { ONE_BOUNCE_FACTOR } else { 1.0 };
                 let share = where_it_lies.min((unseen.powi(i32::from(steps)) * nearer).min(1.0));
@@ -165,44 +164,42 @@ const ONE_BOUNCE_FACTOR: f64 = 2.0;
 /// the spread grew 5-10%.)
 const SMALLEST_SIDE_SHARE: f64 = 1.0 / 16.0;
 
-/// Of a sensor's view, the share a side may fill and trace the usual rays.
-const USUAL_VIEW_SHARE: f64 = 1.0 / 8.0;
+/// Of a sensor's view, the share a side may fill and trace the usual rays
+/// (four of a sensor's 256 probe rays).
+const USUAL_VIEW_SHARE: f64 = 1.0 / 64.0;
 /// The most rays a side a sensor sees traces, in units of the usual.
 const MOST_RAYS_SEEN: f64 = 16.0;
-/// A side filling this share of a sensor's view or more traces rays for
-/// its width ([`rays_for_width`]).
-const WIDE_IN_VIEW: f64 = 1.0 / 64.0;
-/// The most rays a side traces for its width, in units of the usual.
-const MOST_RAYS_WIDE: f64 = 4.0;
 
 /// The rays a side filling `view` of some sensor's view traces, in units of
-/// `rays_per_patch`: (view / [`USUAL_VIEW_SHARE`])², at least 1 and at most
+/// `rays_per_patch`: view / [`USUAL_VIEW_SHARE`], at least 1 and at most
 /// [`MOST_RAYS_SEEN`]. A reading is the sum of its sides' light weighted by
 /// the share of its view each fills, so a side's noise reaches it in that
-/// share, squared in its variance. In a room a side fills a few hundredths
-/// and a reading averages the noise of many; a sensor under a roof's slope
-/// in SampleHouse's attic saw 95% of one side, whose 256 rays met a
+/// share, squared in its variance; for a given number of rays in all, a
+/// reading's variance is least with each side's rays in proportion to its
+/// share (Neyman's allocation), not its square, which spent them on the few
+/// sides filling an eighth of a view or more (a sensor under a roof's
+/// slope in SampleHouse's attic saw 95% of one side, whose 256 rays met a
 /// sunlit eave outside through a seam once in some seeds and not in
-/// others: it read 35, 36, 73, 35 and 38 lx over five seeds.
-fn rays_for_view(view: f64) -> f64 {
-    (view / USUAL_VIEW_SHARE).powi(2).clamp(1.0, MOST_RAYS_SEEN)
-}
-
-/// The rays a side `wide` finest patches large traces, in units of
-/// `rays_per_patch`, where it fills `view` of some sensor's view: as many
-/// as those patches would, up to [`MOST_RAYS_WIDE`], once it fills
-/// [`WIDE_IN_VIEW`] of it and is two finest patches or more (a cell joined
-/// by an edge sliver, at most one and a half, is the finest grid's own). A tall room's ceiling, coarser 2 m above its
+/// others: it read 35, 36, 73, 35 and 38 lx over five seeds). A side's
+/// noise also reaches a reading back and forth between it and the sides
+/// near it, where a row of form factors estimated by few rays meets itself
+/// (the mean of a square is more than the square of the mean): the rooms
+/// seen through a few large sides read high. With the share linear (1/8
+/// squared before), the five real models' 823 referenced sensors against
+/// rtrace, single seeds, median/p90 1.04/4.34 → 0.90/3.66%, the mean of six
+/// seeds' p90 3.21 → 2.65%; FZK-Haus's gallery +2.85 → +2.35% clear, +2.32
+/// → +1.74% overcast, ExampleHOM's children's rooms +1.7 → +1.0-1.2%, the 3
+/// rooms' L +1.05 → 0.01%; cold `sensors` 10-21% longer on whole houses
+/// (SampleHouse 1.90 → 2.29 s), as before on one office's sensors. A side
+/// wider than a finest patch fills more of a view and so traces more: a
+/// tall room's ceiling, coarser 2 m above its
 /// grid (`PatchSizing`), is as smooth to the sensors as its finest patches
 /// were (the furnished floor's readings, three seeds: their spread 0.91%
-/// rms with finest patches, 1.21% coarser with the usual rays, 0.96% with
-/// these); the far ground seen through a window, wide but a sliver of a
-/// view, keeps the usual rays.
-fn rays_for_width(wide: f64, view: f64) -> f64 {
-    if wide < 2.0 {
-        return 1.0;
-    }
-    wide.min(view / WIDE_IN_VIEW).clamp(1.0, MOST_RAYS_WIDE)
+/// rms with finest patches, 1.21% coarser with the usual rays), while the
+/// far ground seen through a window, wide but a sliver of a view, keeps
+/// the usual rays.
+fn rays_for_view(view: f64) -> f64 {
+    (view / USUAL_VIEW_SHARE).clamp(1.0, MOST_RAYS_SEEN)
 }
 
 /// Where a receiver's hemisphere light comes from: the **daylight
@@ -1269,7 +1266,7 @@ mod tests {
         // One bounce away: half of the 64 rays (`ONE_BOUNCE_FACTOR` times a quarter).
         assert!(floor.iter().all(|&(s, named)| s == Sight(1) && named <= 32), "{floor:?}");
         assert!(other_floor.iter().all(|&(s, named)| s == Sight::FARTHER && named <= 1), "{other_floor:?}");
-        assert_eq!(Sight::SEEN.ray_share(0.5, 0.25, 0.02, 0.3), 1.0, "a seen side keeps its rays wherever it lies");
+        assert_eq!(Sight::SEEN.ray_share(0.5, 0.25, 0.01, 0.3), 1.0, "a seen side keeps its rays wherever it lies");
         assert_eq!(
             [1, 2, 3].map(|steps| Sight(steps).ray_share(1.0, 0.25, 0.0, 4.0)),
             [0.5, 0.0625, 0.015625],
@@ -1290,11 +1287,10 @@ mod tests {
         assert_eq!(Sight(3).ray_share(1.0, 0.25, 0.0, 0.01), 1.0 / 64.0, "but no fewer than the farthest sides");
         assert_eq!(Sight::SEEN.ray_share(1.0, 0.25, 0.0, 0.01), 1.0, "and a seen one keeps them");
         assert_eq!(
-            [0.25, 0.5, 0.95].map(|view| Sight::SEEN.ray_share(1.0, 0.25, view, 1.0)),
-            [4.0, 16.0, 16.0],
-            "more where it fills a view"
+            [0.01, 1.0 / 32.0, 0.125, 0.25, 0.95].map(|view| Sight::SEEN.ray_share(1.0, 0.25, view, 1.0)),
+            [1.0, 2.0, 8.0, 16.0, 16.0],
+            "more where it fills a view, in proportion"
         );
-        assert_eq!([2.0, 4.0, 64.0].map(|wide| Sight::SEEN.ray_share(1.0, 0.25, 0.1, wide)), [2.0, 4.0, 4.0], "more where it is wide");
-        assert_eq!(Sight::SEEN.ray_share(1.0, 0.25, 0.001, 64.0), 1.0, "but not where it is a sliver of the view");
+        assert_eq!(Sight::SEEN.ray_share(1.0, 0.25, 0.001, 64.0), 1.0, "a wide side a sliver of the view keeps the usual rays");
     }
 }
