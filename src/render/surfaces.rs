@@ -352,7 +352,7 @@ fn underlay_mesh(scene: &Scene, material: u32) -> (Mesh, SurfaceValues) {
             let node = builder.values.nodes.len() as u32;
             builder.values.nodes.push(sides);
             let normal = if back { -surface.normal } else { surface.normal };
-            for triangle in &scene.triangles[surface.triangles.start as usize..surface.triangles.end as usize] {
+            for triangle in &scene.triangles[surface.triangle_indices()] {
                 let [a, b, c] = triangle.vertices;
                 builder.triangle(if back { [a, c, b] } else { [a, b, c] }, normal, [node; 3]);
             }
@@ -415,7 +415,7 @@ fn material_mesh(scene: &Scene, material: u32) -> Option<(Mesh, SurfaceValues)> 
     let mut node_of: HashMap<(u32, bool, [i64; 3]), u32> = HashMap::new();
     let mut node_normals: Vec<Vec3> = Vec::new();
     for (p, patch) in scene.patches.patches.iter().enumerate().filter(|(_, p)| p.material == material) {
-        let triangles = &scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize];
+        let triangles = &scene.patches.triangles[patch.triangle_indices()];
         for back in [false, true] {
             let side = side_of(p as u32, back);
             let normal = if back { -patch.normal } else { patch.normal };

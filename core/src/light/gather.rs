@@ -856,8 +856,7 @@ impl LightModel {
             .iter()
             .enumerate()
             .map(|(k, window)| {
-                let range = scene.surfaces[window.surface as usize].triangles.clone();
-                let triangles = &scene.triangles[range.start as usize..range.end as usize];
+                let triangles = scene.surface_triangles(window.surface);
                 let (lo, hi) = crate::scene::bounds(triangles);
                 WindowTarget {
                     window: k as u32,
@@ -880,8 +879,7 @@ impl LightModel {
 
     /// A patch's render triangles with their cumulative areas.
     pub(super) fn patch_triangles(&self, patch: usize) -> Vec<([DVec3; 3], f64)> {
-        let range = self.scene.patches.patches[patch].triangles.clone();
-        with_cumulative_areas(self.scene.patches.triangles[range.start as usize..range.end as usize].iter().copied())
+        with_cumulative_areas(self.scene.patches.triangles[self.scene.patches.patches[patch].triangle_indices()].iter().copied())
     }
 
     /// What each sensor sees, by a few rays from each

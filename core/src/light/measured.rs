@@ -86,8 +86,7 @@ impl LightModel {
         let triangles: Vec<(u32, [DVec3; 3], f64)> = (self.scene.windows.iter().enumerate())
             .filter(|(_, w)| self.group_of_surface[w.surface as usize] == Some(group as u32))
             .flat_map(|(k, w)| {
-                let range = self.scene.surfaces[w.surface as usize].triangles.clone();
-                self.scene.triangles[range.start as usize..range.end as usize].iter().map(move |t| {
+                self.scene.surface_triangles(w.surface).iter().map(move |t| {
                     let t = t.vertices.map(|v| v.as_dvec3());
                     (k as u32, t, 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())
                 })

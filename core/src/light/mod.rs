@@ -288,8 +288,7 @@ impl LightModel {
         let mut panel_windows = vec![Vec::new(); panel_groups.len()];
         for window in &scene.windows {
             if let Some(group) = group_of_surface[window.surface as usize] {
-                let range = scene.surfaces[window.surface as usize].triangles.clone();
-                let triangles = scene.triangles[range.start as usize..range.end as usize].iter().map(|t| t.vertices.map(|v| v.as_dvec3()));
+                let triangles = scene.surface_triangles(window.surface).iter().map(|t| t.vertices.map(|v| v.as_dvec3()));
                 panel_windows[group as usize].extend(triangles);
             }
         }
@@ -302,7 +301,7 @@ impl LightModel {
             .patches
             .patches
             .iter()
-            .map(|patch| landings::PatchBox::around(&scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize]))
+            .map(|patch| landings::PatchBox::around(&scene.patches.triangles[patch.triangle_indices()]))
             .collect();
         let patches = &scene.patches.patches;
         let ray_shares = par_map(settings.threads, patches.len(), |p| scene.patch_sizing.ray_share(patches[p].centroid));

@@ -121,8 +121,7 @@ impl Openings {
             .windows
             .iter()
             .map(|window| {
-                let range = scene.surfaces[window.surface as usize].triangles.clone();
-                let corners = scene.triangles[range.start as usize..range.end as usize].iter().flat_map(|t| t.vertices);
+                let corners = scene.surface_triangles(window.surface).iter().flat_map(|t| t.vertices);
                 let (min, max) =
                     corners.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| (lo.min(v.as_dvec3()), hi.max(v.as_dvec3())));
                 ([min - MARGIN, max + MARGIN], group_of_surface[window.surface as usize])
@@ -134,7 +133,7 @@ impl Openings {
             .iter()
             .map(|patch| {
                 let centre = patch.centroid.as_dvec3();
-                let triangles = &scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize];
+                let triangles = &scene.patches.triangles[patch.triangle_indices()];
                 let radius = triangles.iter().flatten().map(|v| v.as_dvec3().distance(centre)).fold(0.0, f64::max);
                 (centre, radius)
             })

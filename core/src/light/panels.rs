@@ -98,10 +98,7 @@ impl LightModel {
                     .iter()
                     .filter(|w| self.group_of_surface[w.surface as usize] == Some(g as u32))
                     .flat_map(|w| {
-                        let range = self.scene.surfaces[w.surface as usize].triangles.clone();
-                        let triangles = with_cumulative_areas(
-                            self.scene.triangles[range.start as usize..range.end as usize].iter().map(|t| t.vertices),
-                        );
+                        let triangles = with_cumulative_areas(self.scene.surface_triangles(w.surface).iter().map(|t| t.vertices));
                         (0..OUTLOOK_POINTS).map(|_| sample_area(&triangles, &mut rng) + outward * SURFACE_OFFSET).collect::<Vec<_>>()
                     })
                     .collect();

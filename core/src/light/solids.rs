@@ -44,7 +44,7 @@ pub(super) fn dark_sides(scene: &Scene) -> Vec<bool> {
     let mut first = vec![None; scene.surfaces.len()];
     for (k, surface) in scene.surfaces.iter().enumerate().filter(|(_, s)| opaque(s.material)) {
         first[k] = Some(triangles.len());
-        for triangle in &scene.triangles[surface.triangles.start as usize..surface.triangles.end as usize] {
+        for triangle in &scene.triangles[surface.triangle_indices()] {
             triangles.push(triangle.vertices);
             vertices.push(triangle.file_vertices);
         }
@@ -155,7 +155,7 @@ fn open_shells_holding_windows(scene: &Scene, triangles: &[[glam::Vec3; 3]], she
         .surfaces
         .iter()
         .filter(|s| passes_light(s.material))
-        .flat_map(|s| &scene.triangles[s.triangles.start as usize..s.triangles.end as usize])
+        .flat_map(|s| &scene.triangles[s.triangle_indices()])
         .flat_map(|t| {
             let centre = t.centroid().as_dvec3();
             let normal = t.normal().as_dvec3() * WINDOW_PROBE;

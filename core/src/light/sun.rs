@@ -307,7 +307,7 @@ impl LightModel {
         let patch = &self.scene.patches.patches[side / 2];
         let middle = patch.centroid.as_dvec3();
         let mut corners: Vec<DVec3> = Vec::new();
-        let vertices = self.scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize].iter().flatten();
+        let vertices = self.scene.patches.triangles[patch.triangle_indices()].iter().flatten();
         for vertex in vertices.map(|v| v.as_dvec3()) {
             if corners.len() == PROBED_CORNERS {
                 break;

@@ -73,8 +73,7 @@ impl WindowGroups {
 /// glazing bars crossing there.
 fn outward_normal(scene: &Scene, tracer: &Tracer, window: &Window) -> (DVec3, bool) {
     let normal = window.normal.as_dvec3();
-    let range = scene.surfaces[window.surface as usize].triangles.clone();
-    let triangles = with_cumulative_areas(scene.triangles[range.start as usize..range.end as usize].iter().map(|t| t.vertices));
+    let triangles = with_cumulative_areas(scene.surface_triangles(window.surface).iter().map(|t| t.vertices));
     let mut rng = Rng::new(5, u64::from(window.surface));
     let open = |side: DVec3, rng: &mut Rng| {
         let points: Vec<DVec3> = stratified_area_points(&triangles, SIDE_RAYS, rng).collect();

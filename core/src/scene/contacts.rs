@@ -67,7 +67,7 @@ impl<'a> LargeFaces<'a> {
         let mut large = vec![false; triangles.len()];
         let mut surface_span = vec![0.0; triangles.len()];
         for surface in surfaces {
-            let own = surface.triangles.start as usize..surface.triangles.end as usize;
+            let own = surface.triangle_indices();
             let (lo, hi) = bounds(&triangles[own.clone()]);
             surface_span[own.clone()].fill((hi - lo).max_element());
             large[own].fill(surface.area >= min_area);
@@ -112,7 +112,7 @@ impl<'a> LargeFaces<'a> {
     /// zone box an export drew over the façade, or the glazed face of a
     /// window's lining lying on the wall's reveal.
     pub fn covered_quarters(&self, surface: &Surface, counts: impl Fn(usize) -> bool) -> Vec<u8> {
-        let own = surface.triangles.start as usize..surface.triangles.end as usize;
+        let own = surface.triangle_indices();
         let tris = &self.triangles[own.clone()];
         let (lo, hi) = bounds(tris);
         let (normal, offset) = (surface.normal, surface.normal.dot(tris[0].vertices[0]));
@@ -139,7 +139,7 @@ impl<'a> LargeFaces<'a> {
     /// The share (0-1) of `surface`'s area under opaque faces in its own
     /// plane ([`Self::covered_quarters`]).
     pub fn covered_share(&self, surface: &Surface, opaque: impl Fn(u32) -> bool) -> f32 {
-        let tris = &self.triangles[surface.triangles.start as usize..surface.triangles.end as usize];
+        let tris = &self.triangles[surface.triangle_indices()];
         let quarters = self.covered_quarters(surface, |t| opaque(self.triangles[t].material));
         let covered: f32 = tris.iter().zip(quarters).map(|(t, q)| t.area() * f32::from(q) / 4.0).sum();
         covered / surface.area.max(f32::MIN_POSITIVE)
@@ -158,7 +158,7 @@ pub fn contact_cuts(large: &LargeFaces, surfaces: &[Surface]) -> Vec<Vec<CutPlan
     let (triangles, grid) = (large.triangles, &large.grid);
     par_map(None, surfaces.len(), |index| {
         let surface = &surfaces[index];
-        let own = surface.triangles.start as usize..surface.triangles.end as usize;
+        let own = surface.triangle_indices();
         let tris = &triangles[own.clone()];
         let (lo, hi) = bounds(tris);
         let flat = Flat::new(surface.normal, tris);

@@ -179,6 +179,18 @@ pub struct Surface {
     pub area: f32,
 }
 
+impl Surface {
+    /// Its triangles' indices into [`Scene::triangles`].
+    pub fn triangle_indices(&self) -> Range<usize> {
+        self.triangles.start as usize..self.triangles.end as usize
+    }
+
+    /// Its patches' indices into [`PatchMesh::patches`].
+    pub fn patch_indices(&self) -> Range<usize> {
+        self.patches.start as usize..self.patches.end as usize
+    }
+}
+
 /// An aperture: a surface of a transmitting material (glass or panel).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Window {
@@ -346,7 +358,7 @@ fn build(
             .iter()
             .enumerate()
             .filter(|(index, _)| box_faces.binary_search(&(*index as u32)).is_err())
-            .flat_map(|(_, s)| triangles[s.triangles.start as usize..s.triangles.end as usize].iter().copied())
+            .flat_map(|(_, s)| triangles[s.triangle_indices()].iter().copied())
             .collect();
         (triangles, surfaces) = surfaces::group(keep);
     }
@@ -404,13 +416,8 @@ fn build(
             ),
         ));
     }
-    let window_planes: Vec<CutPlane> = windows
-        .iter()
-        .map(|w| {
-            let range = surfaces[w.surface as usize].triangles.clone();
-            CutPlane::around_window(w.normal, &triangles[range.start as usize..range.end as usize])
-        })
-        .collect();
+    let window_planes: Vec<CutPlane> =
+        windows.iter().map(|w| CutPlane::around_window(w.normal, &triangles[surfaces[w.surface as usize].triangle_indices()])).collect();
     let covered: Vec<(usize, f32)> = windows
         .iter()
         .map(|w| large.covered_share(&surfaces[w.surface as usize], opaque))
@@ -441,13 +448,8 @@ fn sizing_and_focus(
     surfaces: &[Surface],
     windows: &[Window],
 ) -> (PatchSizing, Option<(Vec3, Vec3)>) {
-    let window_bounds: Vec<(Vec3, Vec3)> = windows
-        .iter()
-        .map(|w| {
-            let range = surfaces[w.surface as usize].triangles.clone();
-            bounds(&triangles[range.start as usize..range.end as usize])
-        })
-        .collect();
+    let window_bounds: Vec<(Vec3, Vec3)> =
+        windows.iter().map(|w| bounds(&triangles[surfaces[w.surface as usize].triangle_indices()])).collect();
     let focus = window_bounds
         .iter()
         .copied()
@@ -510,6 +512,11 @@ pub(crate) fn bounds(triangles: &[Triangle]) -> (Vec3, Vec3) {
 }
 
 impl Scene {
+    /// The triangles of surface `surface`.
+    pub fn surface_triangles(&self, surface: u32) -> &[Triangle] {
+        &self.triangles[self.surfaces[surface as usize].triangle_indices()]
+    }
+
     /// The material of index `id`, as triangles, surfaces, patches and windows
     /// hold it.
     pub fn material(&self, id: u32) -> &Material {
@@ -537,10 +544,10 @@ impl Scene {
         for &index in surfaces {
             let surface = &mut self.surfaces[index as usize];
             surface.material = new;
-            for triangle in &mut self.triangles[surface.triangles.start as usize..surface.triangles.end as usize] {
+            for triangle in &mut self.triangles[surface.triangle_indices()] {
                 triangle.material = new;
             }
-            for patch in &mut self.patches.patches[surface.patches.start as usize..surface.patches.end as usize] {
+            for patch in &mut self.patches.patches[surface.patch_indices()] {
                 patch.material = new;
             }
         }

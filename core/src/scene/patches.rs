@@ -71,6 +71,13 @@ pub struct Patch {
     pub triangles: Range<u32>,
 }
 
+impl Patch {
+    /// Its render triangles' indices into [`PatchMesh::triangles`].
+    pub fn triangle_indices(&self) -> Range<usize> {
+        self.triangles.start as usize..self.triangles.end as usize
+    }
+}
+
 /// Patches and the render triangles they cover.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PatchMesh {
@@ -92,7 +99,7 @@ impl PatchMesh {
         let (mut area, mut moment, mut normal) = (0.0, Vec3::ZERO, Vec3::ZERO);
         for &member in cluster {
             let surface = &surfaces[member as usize];
-            for triangle in &triangles[surface.triangles.start as usize..surface.triangles.end as usize] {
+            for triangle in &triangles[surface.triangle_indices()] {
                 let a = triangle.area();
                 area += a;
                 moment += a * triangle.centroid();
@@ -124,7 +131,7 @@ impl PatchMesh {
     pub fn triangle_patches(&self) -> Vec<u32> {
         let mut owner = vec![0; self.triangles.len()];
         for (p, patch) in self.patches.iter().enumerate() {
-            owner[patch.triangles.start as usize..patch.triangles.end as usize].fill(p as u32);
+            owner[patch.triangle_indices()].fill(p as u32);
         }
         owner
     }
@@ -656,7 +663,7 @@ impl Quadtree {
 pub fn estimate(triangles: &[Triangle], surfaces: &[Surface], sizing: &PatchSizing, limit: u64) -> u64 {
     let mut count = 0;
     for surface in surfaces {
-        let tris = &triangles[surface.triangles.start as usize..surface.triangles.end as usize];
+        let tris = &triangles[surface.triangle_indices()];
         let tree = Quadtree::for_surface(sizing, surface, tris);
         tree.count_leaves(tree.root, &mut count, limit);
         if count >= limit {
@@ -700,7 +707,7 @@ fn clusters(
     let mut members: Vec<Vec<u32>> = Vec::new();
     let mut cluster_of = vec![None; surfaces.len()];
     for (index, surface) in surfaces.iter().enumerate() {
-        let tris = &triangles[surface.triangles.start as usize..surface.triangles.end as usize];
+        let tris = &triangles[surface.triangle_indices()];
         let centroid = tris.iter().map(|t| t.centroid() * t.area()).sum::<Vec3>() / surface.area.max(f32::MIN_POSITIVE);
         let allowed = sizing.allowed(centroid, 0.0);
         // Clutter a large face runs through (a rafter or a beam through a
@@ -804,7 +811,7 @@ fn patches_of_surface(
     cuts: &[CutPlane],
     contacts: &[CutPlane],
 ) -> Vec<Pieces> {
-    let tris = &triangles[surface.triangles.start as usize..surface.triangles.end as usize];
+    let tris = &triangles[surface.triangle_indices()];
     let tree = Quadtree::for_surface(sizing, surface, tris);
     let (u, v) = (tree.u, tree.v);
     let cell_of = |p: Vec3| tree.cell_of(p);
@@ -993,7 +1000,7 @@ mod tests {
         for patch in &mesh.patches {
             assert!((patch.area - 0.25).abs() < 1e-5, "patch area {}", patch.area);
             assert!((patch.normal - Vec3::NEG_Y).length() < 1e-6);
-            let pieces = &mesh.triangles[patch.triangles.start as usize..patch.triangles.end as usize];
+            let pieces = &mesh.triangles[patch.triangle_indices()];
             for piece in pieces {
                 // Same winding as the source: the piece's normal is the surface's.
                 let n = (piece[1] - piece[0]).cross(piece[2] - piece[0]).normalize();
@@ -1022,7 +1029,7 @@ mod tests {
             let large = LargeFaces::new(&tris, &surfaces, f32::INFINITY);
             let mesh = subdivide(&tris, &mut surfaces, sizing, &[false], &[], &large);
             let mut spans = mesh.patches.iter().map(|p| {
-                let pieces = &mesh.triangles[p.triangles.start as usize..p.triangles.end as usize];
+                let pieces = &mesh.triangles[p.triangle_indices()];
                 pieces.iter().flatten().fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), v| (lo.min(v.x), hi.max(v.x)))
             });
             let (lo, hi) = spans.find(|&(lo, hi)| lo <= x && x <= hi).expect("a patch covers x");
@@ -1082,7 +1089,7 @@ mod tests {
         // The width along x of the narrowest patch whose box holds (x, z).
         let width_at = |mesh: &PatchMesh, x: f32, z: f32| {
             let boxes = mesh.patches.iter().map(|p| {
-                let pieces = &mesh.triangles[p.triangles.start as usize..p.triangles.end as usize];
+                let pieces = &mesh.triangles[p.triangle_indices()];
                 pieces.iter().flatten().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)))
             });
             let holding = boxes.filter(|(lo, hi)| lo.x <= x && x <= hi.x && lo.z <= z && z <= hi.z);
@@ -1200,7 +1207,7 @@ mod tests {
                 .patches
                 .iter()
                 .map(|p| {
-                    let xs = mesh.triangles[p.triangles.start as usize..p.triangles.end as usize].iter().flatten().map(|v| v.x);
+                    let xs = mesh.triangles[p.triangle_indices()].iter().flatten().map(|v| v.x);
                     (xs.clone().fold(f32::MAX, f32::min), xs.fold(f32::MIN, f32::max), p.area)
                 })
                 .collect();

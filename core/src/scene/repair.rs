@@ -34,7 +34,7 @@ pub const MAX_PANE_THICKNESS: f32 = 0.06;
 /// a box (indices into `surfaces`), and how many panes were found.
 pub fn thick_glass(triangles: &[Triangle], surfaces: &[Surface], materials: &[Material]) -> (Vec<u32>, usize) {
     let glass: Vec<usize> = (0..surfaces.len()).filter(|&s| materials[surfaces[s].material as usize].kind.transmits()).collect();
-    let tris = |s: usize| &triangles[surfaces[s].triangles.start as usize..surfaces[s].triangles.end as usize];
+    let tris = |s: usize| &triangles[surfaces[s].triangle_indices()];
     let centroid = |s: usize| tris(s).iter().map(|t| t.centroid() * t.area()).sum::<Vec3>() / surfaces[s].area.max(f32::MIN_POSITIVE);
     let centres: HashMap<usize, Vec3> = glass.iter().map(|&s| (s, centroid(s))).collect();
     // Glass surfaces by the cell of their centre, for neighbours in near-linear time.

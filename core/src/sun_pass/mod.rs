@@ -83,10 +83,7 @@ impl SunPassFrame {
     /// passes). What shades a panel from the real sun outside is projected
     /// onto the panel and casts along each of its lobes, as in the engine.
     pub fn new(scene: &Scene, model: &LightModel, surfaces: Arc<SunPassSurfaces>, sun: &SunSource, generation: u64) -> Self {
-        let surface_triangles = |surface: u32| {
-            let range = scene.surfaces[surface as usize].triangles.clone();
-            scene.triangles[range.start as usize..range.end as usize].iter().map(|t| t.vertices)
-        };
+        let surface_triangles = |surface: u32| scene.surface_triangles(surface).iter().map(|t| t.vertices);
         let opaque_casters = surfaces.opaque.triangles();
         // Apertures: the window groups (one material facing one way, see
         // `light::windows`), glass passing the sun alike, panels by their lobes.
@@ -419,7 +416,7 @@ pub fn lit_vertices(scene: &Scene) -> Vec<f32> {
     let mut seen = std::collections::HashSet::new();
     for patch in &scene.patches.patches {
         let MaterialKind::Diffuse { reflectance } = &scene.materials[patch.material as usize].kind else { continue };
-        for triangle in &scene.patches.triangles[patch.triangles.start as usize..patch.triangles.end as usize] {
+        for triangle in &scene.patches.triangles[patch.triangle_indices()] {
             let mut key = triangle.map(|v| v.to_array().map(f32::to_bits));
             key.sort_unstable();
             if !seen.insert(key) {
