@@ -185,15 +185,15 @@ const MOST_RAYS_SEEN: f64 = 16.0;
 /// near it, where a row of form factors estimated by few rays meets itself
 /// (the mean of a square is more than the square of the mean): the rooms
 /// seen through a few large sides read high. With the share linear (1/8
-/// squared before), the five real models' 823 referenced sensors against
-/// rtrace, single seeds, median/p90 1.04/4.34 → 0.90/3.66%, the mean of six
-/// seeds' p90 3.21 → 2.65%; FZK-Haus's gallery +2.85 → +2.35% clear, +2.32
-/// → +1.74% overcast, ExampleHOM's children's rooms +1.7 → +1.0-1.2%, the 3
-/// rooms' L +1.05 → 0.01%; cold `sensors` 10-21% longer on whole houses
-/// (SampleHouse 1.90 → 2.29 s), as before on one office's sensors. A side
-/// wider than a finest patch fills more of a view and so traces more: a
-/// tall room's ceiling, coarser 2 m above its
-/// grid (`PatchSizing`), is as smooth to the sensors as its finest patches
+/// squared before), four real models' 823 referenced sensors in six cases
+/// against rtrace, single seeds, median/p90 1.04/4.34 → 0.90/3.66%, the
+/// mean of six seeds' p90 3.21 → 2.65%; FZK-Haus's gallery +2.85 → +2.35%
+/// clear, +2.32 → +1.74% overcast, ExampleHOM's children's rooms +1.7 →
+/// +1.0-1.2%, the 3 rooms' L +1.05 → 0.01%; cold `sensors` 10-21% longer on
+/// whole houses (SampleHouse 1.90 → 2.29 s), as before on one office's
+/// sensors. A side wider than a finest patch fills more of a view and so
+/// traces more: a tall room's ceiling, coarser 2 m above its grid
+/// (`PatchSizing`), is as smooth to the sensors as its finest patches
 /// were (the furnished floor's readings, three seeds: their spread 0.91%
 /// rms with finest patches, 1.21% coarser with the usual rays), while the
 /// far ground seen through a window, wide but a sliver of a view, keeps
