@@ -82,16 +82,23 @@ def grid_wall(obj, breaks_u, breaks_v, point, is_window, wall, glass, wall_faces
                 obj.face(wall, corners if wall_faces_uv else corners[::-1])
 
 
-def box(obj, material, lo, hi):
-    """A closed box facing out."""
+def box(obj, material, lo, hi, against=()):
+    """A box facing out; the sides named in `against` lie on another face
+    (a slab's end on a wall) and are left out, or they would lie hidden in
+    that face's plane."""
     (x0, y0, z0), (x1, y1, z1) = lo, hi
     p = lambda x, y, z: (x, y, z)
-    obj.quad(material, p(x0, y0, z1), p(x1, y0, z1), p(x1, y1, z1), p(x0, y1, z1))  # top
-    obj.quad(material, p(x0, y0, z0), p(x0, y1, z0), p(x1, y1, z0), p(x1, y0, z0))  # bottom
-    obj.quad(material, p(x0, y0, z0), p(x1, y0, z0), p(x1, y0, z1), p(x0, y0, z1))  # south
-    obj.quad(material, p(x1, y1, z0), p(x0, y1, z0), p(x0, y1, z1), p(x1, y1, z1))  # north
-    obj.quad(material, p(x0, y1, z0), p(x0, y0, z0), p(x0, y0, z1), p(x0, y1, z1))  # west
-    obj.quad(material, p(x1, y0, z0), p(x1, y1, z0), p(x1, y1, z1), p(x1, y0, z1))  # east
+    sides = {
+        "top": (p(x0, y0, z1), p(x1, y0, z1), p(x1, y1, z1), p(x0, y1, z1)),
+        "bottom": (p(x0, y0, z0), p(x0, y1, z0), p(x1, y1, z0), p(x1, y0, z0)),
+        "south": (p(x0, y0, z0), p(x1, y0, z0), p(x1, y0, z1), p(x0, y0, z1)),
+        "north": (p(x1, y1, z0), p(x0, y1, z0), p(x0, y1, z1), p(x1, y1, z1)),
+        "west": (p(x0, y1, z0), p(x0, y0, z0), p(x0, y0, z1), p(x0, y1, z1)),
+        "east": (p(x1, y0, z0), p(x1, y1, z0), p(x1, y1, z1), p(x1, y0, z1)),
+    }
+    for name, corners in sides.items():
+        if name not in against:
+            obj.quad(material, *corners)
 
 
 def toml_value(v):
@@ -235,8 +242,8 @@ def office():
         obj.face("well", [(x0, y1, top), (x0, y0, top), (x0, y0, H), (x0, y1, H)])  # facing +x
         obj.face("well", [(x1, y0, top), (x1, y1, top), (x1, y1, H), (x1, y0, H)])  # facing -x
         obj.face("skylight_glass", [(x0, y0, top), (x1, y0, top), (x1, y1, top), (x0, y1, top)])  # facing up
-    # Overhang outside the west facade: a slab 0.6 m deep at 3.1-3.15 m.
-    box(obj, "overhang", (-0.6, 0.0, 3.1), (0.0, D, 3.15))
+    # Overhang outside the west facade: a slab 0.6 m deep at 3.1-3.15 m, its end on the wall.
+    box(obj, "overhang", (-0.6, 0.0, 3.1), (0.0, D, 3.15), against=("east",))
     # Desks (top slab + two side panels) in two columns, four rows; low partitions between rows.
     desks = []
     for row, yc in enumerate([2.5, 5.5, 8.5, 11.5]):

@@ -663,6 +663,32 @@ fn glass_on_a_solid_in_its_plane_is_the_solid() {
     assert!(beside.warnings.is_empty(), "{:?}", beside.warnings);
 }
 
+/// A face lying on a larger face of another material in its plane and
+/// facing the same way (a rafter's underside in a roof slab's, as FZK-Haus
+/// has them) is hidden: which of the two a ray meets is rounding, in
+/// Radiance too, so it is dropped, in one warning line. A face on the
+/// other side of that plane, or reaching past the larger face, stays.
+#[test]
+fn a_face_hidden_in_a_larger_one_is_dropped() {
+    let path = on_a_ground("hidden_face", 10.0, 10.0, true);
+    let mut quads = quad_obj::QuadObj::new("room.mtl");
+    // The ceiling is z = 3 over x 0-4, y 0-6, facing down.
+    quads.quad("wall", [[1.0, 1.0, 3.0], [1.0, 5.0, 3.0], [1.2, 5.0, 3.0], [1.2, 1.0, 3.0]]);
+    quads.quad("wall", [[1.5, 1.0, 3.0], [1.7, 1.0, 3.0], [1.7, 5.0, 3.0], [1.5, 5.0, 3.0]]);
+    quads.quad("wall", [[2.5, 1.0, 3.0], [2.5, 12.0, 3.0], [2.7, 12.0, 3.0], [2.7, 1.0, 3.0]]);
+    add_to_room(&path, &quads);
+    let loaded = load_scene(&path, &PanelCatalog::new()).unwrap();
+    let messages: Vec<&str> = loaded.warnings.iter().map(|w| w.message.as_str()).collect();
+    assert_eq!(messages.len(), 1, "{messages:?}");
+    assert!(messages[0].starts_with("2 triangles of 1 surfaces lie on a larger face of another material"), "{}", messages[0]);
+    let scene = &loaded.scene;
+    let wall = scene.materials.iter().position(|m| m.name == "wall").unwrap() as u32;
+    let at_ceiling =
+        |facing: f32| scene.triangles.iter().filter(|t| t.material == wall && t.centroid().z == 3.0 && t.normal().z * facing > 0.0).count();
+    assert_eq!(at_ceiling(-1.0), 2, "the strip reaching past the ceiling stays; the one within it goes");
+    assert_eq!(at_ceiling(1.0), 2, "a strip on the ceiling's other side stays");
+}
+
 /// A pane modelled as a glass box 2 cm thick (as BIM exports write them)
 /// is read as one pane, with one warning: one window, and the light of a
 /// single glass face, not of two (τ²).

@@ -385,6 +385,25 @@ fn build(
         windows = surfaces::windows(&triangles, &surfaces, &materials);
         large = contacts::LargeFaces::new(&triangles, &surfaces, clutter);
     }
+    // An opaque face on a larger one of another material in its plane is hidden.
+    let hidden = repair::hidden_faces(&large, &triangles, &surfaces, opaque);
+    if let Some(&first) = hidden.first() {
+        let first = triangles[first as usize].material;
+        let under = surfaces.iter().filter(|s| s.triangles.clone().any(|t| hidden.binary_search(&t).is_ok())).count();
+        warnings.push(SceneWarning {
+            location: Location::file(obj_path),
+            message: format!(
+                "{} triangles of {under} surfaces lie on a larger face of another material in their own plane, facing the same way (the first of material '{}'): which of the two a ray meets is a matter of rounding, in Radiance too; read as the larger face, they are dropped",
+                hidden.len(),
+                materials[first as usize].name
+            ),
+        });
+        let keep: Vec<Triangle> =
+            triangles.iter().enumerate().filter(|(t, _)| hidden.binary_search(&(*t as u32)).is_err()).map(|(_, t)| *t).collect();
+        (triangles, surfaces) = surfaces::group(keep);
+        windows = surfaces::windows(&triangles, &surfaces, &materials);
+        large = contacts::LargeFaces::new(&triangles, &surfaces, clutter);
+    }
     let sensors = sensors::sensors(parsed)?;
     if windows.is_empty() && !sensors.is_empty() {
         warnings.push(SceneWarning {

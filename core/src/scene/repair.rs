@@ -17,6 +17,12 @@
 //!   the solid's dark inside. Such glass is dropped ([`glass_on_solids`]).
 //!   A pane pasted on a wall modelled as one sheet, or on a closed room
 //!   modelled from within, leads outside and stays a window.
+//! - **Hidden faces.** An opaque face lying wholly on a larger opaque face
+//!   of another material, in its plane and facing the same way (FZK-Haus's
+//!   rafters, whose undersides are the roof slab's underside): which of the
+//!   two a ray meets is a matter of rounding, in Radiance as here, and the
+//!   two tracers round apart. The larger face is what shows; the other is
+//!   dropped ([`hidden_faces`]), so both read the same surface.
 
 use std::collections::HashMap;
 
@@ -26,6 +32,7 @@ use super::contacts::LargeFaces;
 use super::material::Material;
 use super::shells::model_shells;
 use super::{Surface, Triangle, Window};
+use crate::parallel::par_map;
 
 /// Glass faces closer than this (m) are the two sides of one pane.
 pub const MAX_PANE_THICKNESS: f32 = 0.06;
@@ -142,4 +149,36 @@ pub(crate) fn glass_on_solids(
         of_solid[t] = shells.winding[k] == 1;
     }
     covered_by(&|t| of_solid[t])
+}
+
+/// The opaque triangles lying wholly on a larger opaque face of another
+/// material in their own plane, facing the same way (a tie in area goes to
+/// the surface listed first), by index into `triangles`, sorted.
+pub(crate) fn hidden_faces(
+    large: &LargeFaces,
+    triangles: &[Triangle],
+    surfaces: &[Surface],
+    opaque: impl Fn(u32) -> bool + Sync,
+) -> Vec<u32> {
+    let mut surface_of = vec![0; triangles.len()];
+    for (index, surface) in surfaces.iter().enumerate() {
+        surface_of[surface.triangle_indices()].fill(index);
+    }
+    let hidden = par_map(None, surfaces.len(), |index| {
+        let surface = &surfaces[index];
+        if !opaque(surface.material) {
+            return Vec::new();
+        }
+        let shows_over = |t: usize| {
+            let (other, face) = (surface_of[t], &triangles[t]);
+            let over = &surfaces[other];
+            opaque(face.material)
+                && face.material != surface.material
+                && face.normal().dot(surface.normal) > 0.0
+                && (over.area > surface.area || (over.area == surface.area && other < index))
+        };
+        let quarters = large.covered_quarters(surface, shows_over);
+        surface.triangles.clone().zip(quarters).filter(|&(_, q)| q == 4).map(|(t, _)| t).collect()
+    });
+    hidden.into_iter().flatten().collect()
 }
