@@ -316,6 +316,13 @@ pub(crate) struct BuiltModel {
     pub warnings: Vec<SceneWarning>,
 }
 
+/// `triangles` less the ones `gone` names (by index).
+fn without(triangles: &[Triangle], gone: impl IntoIterator<Item = u32>) -> Vec<Triangle> {
+    let mut dropped = vec![false; triangles.len()];
+    gone.into_iter().for_each(|t| dropped[t as usize] = true);
+    triangles.iter().zip(dropped).filter(|(_, dropped)| !dropped).map(|(t, _)| *t).collect()
+}
+
 fn build(
     parsed: &mut file::ParsedScene,
     obj_path: &Path,
@@ -378,10 +385,7 @@ fn build(
                 materials[windows[first].material as usize].name
             ),
         });
-        let mut gone = vec![false; triangles.len()];
-        buried.iter().for_each(|&(_, t)| gone[t as usize] = true);
-        let keep: Vec<Triangle> = triangles.iter().zip(&gone).filter(|(_, gone)| !**gone).map(|(t, _)| *t).collect();
-        (triangles, surfaces) = surfaces::group(keep);
+        (triangles, surfaces) = surfaces::group(without(&triangles, buried.iter().map(|&(_, t)| t)));
         windows = surfaces::windows(&triangles, &surfaces, &materials);
         large = contacts::LargeFaces::new(&triangles, &surfaces, clutter);
     }
@@ -398,9 +402,7 @@ fn build(
                 materials[first as usize].name
             ),
         });
-        let keep: Vec<Triangle> =
-            triangles.iter().enumerate().filter(|(t, _)| hidden.binary_search(&(*t as u32)).is_err()).map(|(_, t)| *t).collect();
-        (triangles, surfaces) = surfaces::group(keep);
+        (triangles, surfaces) = surfaces::group(without(&triangles, hidden.iter().copied()));
         windows = surfaces::windows(&triangles, &surfaces, &materials);
         large = contacts::LargeFaces::new(&triangles, &surfaces, clutter);
     }
