@@ -14,7 +14,9 @@ what the glazing is), an opaque one a diffuse reflectance from its colour
 (Radiance's RGB weights, clamped to 0.05-0.9). An IfcWindow with no
 transparent face at all (early-design exports draw a window as one plain
 box) is glazed, and said so: one pane, the outline of its faces in the
-plane of most area (the wall's opening has its own reveals). Each IfcSpace gets sensors 0.8 m
+plane of most area (the wall's opening has its own reveals). An IfcMember in
+a transparent style (a curtain wall's mullions and transoms drawn in its
+glazing's style) is an opaque frame, and said so. Each IfcSpace gets sensors 0.8 m
 above its floor on a --spacing grid, 0.3 m in from the walls of its box,
 named after the space (its LongName; see `space_names` where long names repeat):
 a sensor grid where the space fills its box, otherwise the grid's points
@@ -169,6 +171,7 @@ def main():
     vertices, faces, materials, spaces, skipped = [], {}, {}, [], {}
     names = dict(zip((s.id() for s in model.by_type("IfcSpace")), space_names(model.by_type("IfcSpace"))))
     glazed_windows = 0
+    framed_members = set()
     iterator = ifcopenshell.geom.iterator(settings, model)
     if not iterator.initialize():
         sys.exit(f"{a.ifc}: no geometry IfcOpenShell can read")
@@ -214,6 +217,12 @@ def main():
                     diffuse = style.diffuse
                     colour = (diffuse.r(), diffuse.g(), diffuse.b()) if diffuse is not None else (0.6, 0.6, 0.6)
                     key = name_of(style.name)
+                    if transparent > 0.3 and product.is_a("IfcMember"):
+                        # A mullion or transom drawn in its curtain wall's
+                        # glazing style: a frame, not glass.
+                        key += "_frame"
+                        framed_members.add(product.id())
+                        transparent = 0.0
                     if transparent > 0.3:
                         key += "_glass"
                         materials.setdefault(key, ("glass", a.transmittance))
@@ -273,6 +282,11 @@ def main():
     if glazed_windows:
         print(f"{glazed_windows} IfcWindow with no transparent face: glazed as one pane, the outline of their faces in the plane of most area (glass, transmittance {a.transmittance})",
               file=sys.stderr)
+    if framed_members:
+        print(f"{len(framed_members)} IfcMember in a transparent style (mullions and transoms drawn in the glazing's style): "
+              "read as opaque frames, their reflectance from the style's colour", file=sys.stderr)
+    if not used:
+        print("no IfcSpace with room for sensors: scene.toml has none; add [[sensor_grids]] or [[sensors]] to it", file=sys.stderr)
     if partial:
         print(f"{partial} spaces do not fill their box: point sensors over their floors instead of a grid", file=sys.stderr)
     print(f"{len(vertices)} vertices, {sum(len(v) for v in faces.values())} triangles, {len(materials)} materials, "
