@@ -24,7 +24,8 @@ over the space's floor, 0.3 m in from its edges too, as point sensors
 `<space>/<k>` (an L-shaped corridor's box reaches into the rooms beside it;
 a point 2 cm from a wall in the notch of such a space sees that wall as half
 its view, and refines the wall's patches around it to a few centimetres). The site's latitude and
-longitude come from IfcSite when given there, and without --timezone the
+longitude come from IfcSite when given there (0°, 0°, said so, where it gives
+none: give --latitude and --longitude), and without --timezone the
 standard time is that of the meridian nearest the longitude (said so: an
 IFC site names no time zone, and UTC at Chicago puts noon at 6 a.m.).
 """
@@ -249,6 +250,12 @@ def main():
     site = next(iter(model.by_type("IfcSite")), None)
     latitude = a.latitude if a.latitude is not None else (angle(site.RefLatitude) if site and site.RefLatitude else 0.0)
     longitude = a.longitude if a.longitude is not None else (angle(site.RefLongitude) if site and site.RefLongitude else 0.0)
+    unplaced = [name for name, given, ref in (("latitude", a.latitude, "RefLatitude"), ("longitude", a.longitude, "RefLongitude"))
+                if given is None and not (site and getattr(site, ref))]
+    if unplaced:
+        # The sun at 0°, 0° is not the site's: say so, rather than answer for the equator.
+        print(f"IfcSite gives no {' or '.join(unplaced)}: scene.toml puts the site at {latitude:.4f}°, {longitude:.4f}°; "
+              f"give --latitude and --longitude for the building's own sun", file=sys.stderr)
     timezone = a.timezone
     if timezone is None:
         timezone = float(round(longitude / 15.0))
