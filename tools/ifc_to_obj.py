@@ -218,13 +218,13 @@ def main():
                     diffuse = style.diffuse
                     colour = (diffuse.r(), diffuse.g(), diffuse.b()) if diffuse is not None else (0.6, 0.6, 0.6)
                     key = name_of(style.name)
-                    if transparent > 0.3 and product.is_a("IfcMember"):
-                        # A mullion or transom drawn in its curtain wall's
-                        # glazing style: a frame, not glass.
+                    # A mullion or transom drawn in its curtain wall's
+                    # glazing style: a frame, not glass.
+                    frame = transparent > 0.3 and product.is_a("IfcMember")
+                    if frame:
                         key += "_frame"
                         framed_members.add(product.id())
-                        transparent = 0.0
-                    if transparent > 0.3:
+                    if transparent > 0.3 and not frame:
                         key += "_glass"
                         materials.setdefault(key, ("glass", a.transmittance))
                     else:
@@ -248,10 +248,15 @@ def main():
             for t in tris:
                 f.write(f"f {t[0]} {t[1]} {t[2]}\n")
     site = next(iter(model.by_type("IfcSite")), None)
-    latitude = a.latitude if a.latitude is not None else (angle(site.RefLatitude) if site and site.RefLatitude else 0.0)
-    longitude = a.longitude if a.longitude is not None else (angle(site.RefLongitude) if site and site.RefLongitude else 0.0)
-    unplaced = [name for name, given, ref in (("latitude", a.latitude, "RefLatitude"), ("longitude", a.longitude, "RefLongitude"))
-                if given is None and not (site and getattr(site, ref))]
+    def coordinate(given, ref):
+        """The flag's value, else IfcSite's, else 0 and whether it fell to that."""
+        if given is not None:
+            return given, False
+        if site and getattr(site, ref):
+            return angle(getattr(site, ref)), False
+        return 0.0, True
+    (latitude, no_latitude), (longitude, no_longitude) = coordinate(a.latitude, "RefLatitude"), coordinate(a.longitude, "RefLongitude")
+    unplaced = [name for name, missing in (("latitude", no_latitude), ("longitude", no_longitude)) if missing]
     if unplaced:
         # The sun at 0°, 0° is not the site's: say so, rather than answer for the equator.
         print(f"IfcSite gives no {' or '.join(unplaced)}: scene.toml puts the site at {latitude:.4f}°, {longitude:.4f}°; "
