@@ -448,9 +448,24 @@ fn open_models_and_sensors_inside_solids_are_handled() {
     let model = LightModel::precompute(scene.clone(), quick_light()).unwrap();
     let lighting = model.solve(&sky_at(&scene, &SkySpec::Overcast, "2026-03-21", "12:00"), None);
     assert!(lighting.sensors.iter().all(|r| r.total.is_finite() && r.total > 0.0));
+    assert!(model.sensors_over_nothing().is_empty(), "the floor is there");
+    // Without its floor, every sensor on the work plane and the floor is
+    // over nothing (and none in the office).
+    let floorless = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_floorless");
+    std::fs::create_dir_all(&floorless).unwrap();
+    for f in ["scene.toml", "model.mtl"] {
+        std::fs::copy(sideroom().with_file_name(f), floorless.join(f)).unwrap();
+    }
+    assert!(obj.contains("usemtl floor\nf 1 2 3 4\n"));
+    std::fs::write(floorless.join("model.obj"), obj.replace("usemtl floor\nf 1 2 3 4\n", "")).unwrap();
+    let scene = load(&floorless.join("scene.toml"));
+    let over_nothing = LightModel::precompute(scene.clone(), quick_light()).unwrap().sensors_over_nothing();
+    let facing_up: Vec<usize> = (0..scene.sensors.len()).filter(|&i| scene.sensors[i].normal.z > 0.99).collect();
+    assert_eq!(facing_up.len(), 17);
+    assert!(facing_up.iter().all(|i| over_nothing.contains(i)), "{over_nothing:?}");
     // A sensor inside the test room's closed desk-like box is flagged.
-    let office = load(&heliodon_core::bundled_scene("office"));
-    assert!(LightModel::precompute(office, quick_light()).unwrap().sensors_inside_solids().is_empty());
+    let office = LightModel::precompute(load(&heliodon_core::bundled_scene("office")), quick_light()).unwrap();
+    assert!(office.sensors_inside_solids().is_empty() && office.sensors_over_nothing().is_empty());
     let inside = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_inside");
     std::fs::create_dir_all(&inside).unwrap();
     let scene_text = std::fs::read_to_string(heliodon_core::bundled_scene("office")).unwrap()

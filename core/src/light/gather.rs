@@ -50,7 +50,7 @@ pub(super) fn check_memory(scene: &Scene, settings: &LightSettings) -> Result<()
 }
 
 /// Sensors closer than this to a surface behind them read as lifted this far.
-const SENSOR_LIFT: f64 = 0.01;
+pub(super) const SENSOR_LIFT: f64 = 0.01;
 
 /// Rays that tell a patch's point inside a solid from a seam a ray
 /// slipped through ([`LightModel::is_buried`]).

@@ -467,6 +467,28 @@ impl LightModel {
             .collect()
     }
 
+    /// Sensors with nothing under them: most rays down from them meet no
+    /// surface and reach the ground below the
+    /// model, as in a room whose floor the model lacks (an architect's
+    /// export without its structural slabs: Revit's Office_A has two
+    /// slabs, both stair landings, and its ground floor's ceilings read the
+    /// ground's glow through the floor that is not there). They still read
+    /// what reaches them; the caller warns.
+    pub fn sensors_over_nothing(&self) -> Vec<usize> {
+        const RAYS: usize = 32;
+        (0..self.scene.sensors.len())
+            .filter(|&i| {
+                let sensor = &self.scene.sensors[i];
+                let mut rng = Rng::new(6, i as u64);
+                let down = cosine_directions(DVec3::NEG_Z, RAYS, &mut rng);
+                // Off the floor a sensor may lie on, as it is placed to measure.
+                let origin = sensor.position.as_dvec3() + sensor.normal.as_dvec3() * gather::SENSOR_LIFT;
+                let open = down.iter().filter(|&&d| self.shadow_tracer.closest(origin, d, 1e-6).is_none()).count();
+                2 * open > RAYS
+            })
+            .collect()
+    }
+
     /// Sensors that seem to sit inside a solid: every ray from them meets a
     /// surface from its back, within a few metres. They still read what
     /// reaches them; the caller warns.

@@ -59,6 +59,15 @@ pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, Stri
         };
         eprintln!("warning: {}: {what}: {named}; they read the light where they are", args.scene.display());
     }
+    let over_nothing: Vec<&str> = model.sensors_over_nothing().into_iter().map(|i| scene.sensors[i].name.as_str()).collect();
+    if !over_nothing.is_empty() {
+        eprintln!(
+            "warning: {}: nothing under {} sensors (rays down from them meet no surface: the model has no floor there): {}; they read the ground's light through it",
+            args.scene.display(),
+            over_nothing.len(),
+            first_few(&over_nothing)
+        );
+    }
     let inside: Vec<&str> = model.sensors_inside_solids().into_iter().map(|i| scene.sensors[i].name.as_str()).collect();
     if !inside.is_empty() {
         let (who, reads) = if inside.len() == 1 {
