@@ -32,11 +32,12 @@
 //! sides at once (in blocks, so memory stays bounded); the coefficients
 //! hold sensors × slots and sensors × patch sides numbers.
 
+use std::io;
 use std::path::Path;
 
 use glam::DVec3;
 
-use super::cache::{self, CacheOutcome, Reader, StableHash, Writer};
+use super::cache::{self, BlockWriter, Blocks, CacheOutcome, Reader, StableHash};
 use super::daylight::{KeyRadiance, RadianceSlots};
 use super::sun::SidesReach;
 use super::{LightModel, SensorReading, SunBeam, luminous, par_map};
@@ -65,6 +66,8 @@ const IMPORTANCE_FLOOR: f32 = 1e-6;
 /// The most coefficients kept in the light cache, bytes: past it (a grid of
 /// tens of thousands of sensors) they are solved each run instead.
 const MAX_CACHED_BYTES: usize = 256 << 20;
+/// Coefficients per block of their cache file (4 MB).
+const VALUES_PER_BLOCK: usize = 1 << 20;
 
 /// Each sensor's interreflected light per unit of every source, for one
 /// model. They hold for the model they were made from and for any that
@@ -163,9 +166,9 @@ impl LightModel {
             Some(dir),
             &format!("{key:016x}-coefficients"),
             key,
-            |payload| SensorCoefficients::from_payload(self, payload),
+            |blocks| SensorCoefficients::load(self, blocks),
             || Ok(self.sensor_coefficients()),
-            SensorCoefficients::payload,
+            SensorCoefficients::save,
         );
         stored.unwrap_or_else(|why| (self.sensor_coefficients(), CacheOutcome::Skipped(why)))
     }
@@ -327,36 +330,31 @@ impl SunLux {
 }
 
 impl SensorCoefficients {
-    /// The coefficients as stored in the light cache.
-    fn payload(&self) -> Vec<u8> {
-        let mut w = Writer::default();
-        w.u32(self.sensors as u32);
-        w.u32(self.iterations as u32);
+    /// Stores the coefficients in the light cache.
+    fn save(&self, out: &mut BlockWriter) -> io::Result<()> {
+        out.block(|w| {
+            w.u32(self.sensors as u32);
+            w.u32(self.iterations as u32);
+        })?;
         for values in [&self.sky, &self.sun] {
-            w.u32(values.len() as u32);
-            values.iter().for_each(|&v| w.f32(v));
+            out.items(values, VALUES_PER_BLOCK, |w, &v| w.f32(v))?;
         }
-        self.seen.iter().for_each(|&seen| w.u32(u32::from(seen)));
-        w.0
+        out.items(&self.seen, VALUES_PER_BLOCK, |w, &seen| w.u32(u32::from(seen)))
     }
 
     /// Coefficients read back from the light cache; `None` when they do not
     /// fit `model`.
-    fn from_payload(model: &LightModel, payload: &[u8]) -> Option<Self> {
-        let mut r = Reader(payload);
+    fn load(model: &LightModel, blocks: &mut Blocks) -> Option<Self> {
         let (sensors, sides, slots) = (model.sensors.len(), model.side_gathers.len(), model.radiance_slots());
+        let head = blocks.next()?;
+        let mut r = Reader(&head);
         if r.u32()? as usize != sensors {
             return None;
         }
         let iterations = r.u32()? as usize;
-        let mut values = |len: usize| -> Option<Vec<f32>> {
-            if r.u32()? as usize != len {
-                return None;
-            }
-            (0..len).map(|_| r.f32()).collect()
-        };
-        let (sky, sun) = (values(slots.len() * sensors)?, values(sides * sensors)?);
-        let seen = (0..sides).map(|_| r.u32().map(|v| v != 0)).collect::<Option<Vec<_>>>()?;
+        let sky = blocks.items(slots.len() * sensors, |r| r.f32())?;
+        let sun = blocks.items(sides * sensors, |r| r.f32())?;
+        let seen = blocks.items(sides, |r| r.u32().map(|v| v != 0))?;
         r.is_empty().then_some(Self { sensors, slots, sky, sun, seen, iterations })
     }
 
