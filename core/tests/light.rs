@@ -405,15 +405,17 @@ fn a_model_beside_another_shares_what_they_have_alike_and_equals_its_own_trace()
     let settings = quick_light();
     // The viewer's model for display: every side's rays, beside the settings' own.
     let display = LightSettings { unseen_ray_share: 1.0, ..settings };
-    let (base, _) = precompute_cached(scene.clone(), settings, None, &|_| {}).unwrap();
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_cache_beside");
+    let _ = std::fs::remove_dir_all(&dir);
+    let (base, _) = precompute_cached(scene.clone(), settings, Some(&dir), &|_| {}).unwrap();
     let (alone, _) = precompute_cached(scene.clone(), display, None, &|_| {}).unwrap();
     let sides = scene.patches.patches.len() * 2;
     let shared = |model: &LightModel| (0..sides).filter(|&s| std::ptr::eq(model.side_gather(s), base.side_gather(s))).count();
     let sky = sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-03-21", "10:00");
     let expected = alone.solve(&sky, None);
-    // Traced beside the settings' model, and read from the cache beside it.
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("light_cache_beside");
-    let _ = std::fs::remove_dir_all(&dir);
+    // Traced beside the settings' model, and read from the cache beside it:
+    // the sensors are the settings' model's, and its file names that model
+    // in their place.
     for outcome_is_hit in [false, true] {
         let (model, outcome) = precompute_cached_beside(scene.clone(), display, Some(&base), Some(&dir), &|_| {}).unwrap();
         assert_eq!(matches!(outcome, CacheOutcome::Hit(_)), outcome_is_hit, "{outcome:?}");
@@ -428,7 +430,12 @@ fn a_model_beside_another_shares_what_they_have_alike_and_equals_its_own_trace()
         // settings' model's, held once; the others, given more rays, differ.
         let (own, alike) = (shared(&model), (0..sides).filter(|&s| base.side_gather(s) == alone.side_gather(s)).count());
         assert!(own > 0 && own == alike && alike < sides, "{own} of {alike} sides alike shared, {sides} sides");
+        assert!(std::ptr::eq(model.sensor_gather(0), base.sensor_gather(0)));
     }
+    // Without that model beside, the file does not do: traced again.
+    let (again, outcome) = precompute_cached(scene.clone(), display, Some(&dir), &|_| {}).unwrap();
+    assert!(matches!(&outcome, CacheOutcome::Rebuilt(_, why) if why.contains("do not fit")), "{outcome:?}");
+    assert_eq!(again.solve(&sky, None), expected);
     // A model alone shares nothing.
     assert_eq!(shared(&alone), 0);
 }

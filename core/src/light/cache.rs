@@ -26,7 +26,7 @@ use crate::sky::SkyPatches;
 
 const MAGIC: &[u8; 8] = b"HELIOLT\0";
 /// Bump when the model or its layout changes.
-const FORMAT: u32 = 22;
+const FORMAT: u32 = 23;
 
 /// What happened to the cache.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -922,9 +922,10 @@ impl Reader<'_> {
     }
 }
 
-/// What a model gathered: per patch side, and its sensors; and which of
-/// each are open to the sun ([`super::openings::Spaces`]).
-type Gathered = (Vec<Arc<Gather>>, Arc<Vec<SensorGeometry>>, (Vec<bool>, Vec<bool>));
+/// What a model gathered: per patch side, and its sensors (with the key of
+/// the model they are shared with, if they are); and which of each are open
+/// to the sun ([`super::openings::Spaces`]).
+type Gathered = (Vec<Arc<Gather>>, (Arc<Vec<SensorGeometry>>, Option<u64>), (Vec<bool>, Vec<bool>));
 
 impl LightModel {
     /// The gathered data, for the cache.
@@ -935,9 +936,19 @@ impl LightModel {
         out.block(|w| {
             w.u32(self.side_gathers.len() as u32);
             w.u32(self.sensors.len() as u32);
+            // Sensors shared with another model: its key, not them again.
+            match self.sensors_of {
+                Some(key) => {
+                    w.u8(1);
+                    w.u64(key);
+                }
+                None => w.u8(0),
+            }
         })?;
         out.items(&self.side_gathers, GATHERS_PER_BLOCK, |w, g| w.gather(g))?;
-        out.items(&self.sensors, SENSORS_PER_BLOCK, |w, s| s.write(w))?;
+        if self.sensors_of.is_none() {
+            out.items(&self.sensors, SENSORS_PER_BLOCK, |w, s| s.write(w))?;
+        }
         out.block(|w| {
             w.flags(&self.open_sides);
             w.flags(&self.open_sensors);
@@ -957,22 +968,32 @@ impl LightModel {
             Some(Arc::new(Tracer::from_bytes(&tracer_bytes, &triangles, &owner)?))
         };
         drop(tracer_bytes);
-        let (side_gathers, sensors, (open_sides, open_sensors)) = Self::read_payload(scene, settings, blocks)?;
+        let beside = beside.filter(|b| Arc::ptr_eq(&b.scene, scene));
+        let (side_gathers, (sensors, sensors_of), (open_sides, open_sensors)) = Self::read_payload(scene, settings, beside, blocks)?;
         let empty = Self::empty(scene.clone(), settings, beside, stored);
-        Some(LightModel { side_gathers, sensors, open_sides, open_sensors, ..empty }.sharing(beside))
+        Some(LightModel { side_gathers, sensors, sensors_of, open_sides, open_sensors, ..empty }.sharing(beside))
     }
 
     /// The side gathers and sensor geometries a file's blocks hold after
-    /// its tracer, if they fit the scene.
-    fn read_payload(scene: &Scene, settings: LightSettings, blocks: &mut Blocks) -> Option<Gathered> {
+    /// its tracer, if they fit the scene; sensors it holds as those of
+    /// another model, `beside`'s when it is that model (else it does not fit).
+    fn read_payload(scene: &Scene, settings: LightSettings, beside: Option<&LightModel>, blocks: &mut Blocks) -> Option<Gathered> {
         let counts = blocks.next()?;
         let mut r = Reader(&counts);
         let (sides, sensor_count) = (r.u32()? as usize, r.u32()? as usize);
+        let sensors_of = match r.u8()? {
+            0 => None,
+            1 => Some(r.u64()?),
+            _ => return None,
+        };
         if !r.is_empty() || sides != scene.patches.patches.len() * 2 || sensor_count != scene.sensors.len() {
             return None;
         }
         let side_gathers = blocks.items(sides, |r| r.gather())?;
-        let sensors = blocks.items(sensor_count, SensorGeometry::read)?;
+        let sensors = match sensors_of {
+            None => Arc::new(blocks.items(sensor_count, SensorGeometry::read)?),
+            Some(key) => beside.filter(|b| b.cache_key.get() == Some(&key))?.sensors.clone(),
+        };
         let flags = blocks.next()?;
         let mut r = Reader(&flags);
         let open = (r.flags(sides)?, r.flags(sensor_count)?);
@@ -980,12 +1001,13 @@ impl LightModel {
         let patch_sides = sides as u32;
         let fits = |g: &Gather| g.daylight_coefficients.iter().all(|b| b.0 < bins) && g.form_factors.iter().all(|s| s.0 < patch_sides);
         let hits_fit = |s: &SensorGeometry| s.landings.fits(patch_sides);
-        if !r.is_empty() || !side_gathers.iter().all(fits) || !sensors.iter().all(|s| fits(&s.gather) && hits_fit(s)) {
+        let sensors_fit = sensors_of.is_some() || sensors.iter().all(|s| fits(&s.gather) && hits_fit(s));
+        if !r.is_empty() || !side_gathers.iter().all(fits) || !sensors_fit {
             return None;
         }
         let nothing = Arc::new(Gather::default());
         let shared = |g: Gather| if g == *nothing { nothing.clone() } else { Arc::new(g) };
-        Some((side_gathers.into_iter().map(shared).collect(), Arc::new(sensors), open))
+        Some((side_gathers.into_iter().map(shared).collect(), (sensors, sensors_of), open))
     }
 
     /// This model (read from the cache) with what it has alike with
@@ -999,7 +1021,7 @@ impl LightModel {
                 *own = theirs.clone();
             }
         }
-        if self.sensors == beside.sensors {
+        if !Arc::ptr_eq(&self.sensors, &beside.sensors) && self.sensors == beside.sensors {
             self.sensors = beside.sensors.clone();
         }
         self
@@ -1020,15 +1042,8 @@ impl Landings {
             w.varint(e - end);
             (side, end) = (s, e);
         }
-        let mut repeats: Vec<(u32, f32)> = Vec::new();
-        for &share in shares {
-            match repeats.last_mut() {
-                Some((count, value)) if value.to_bits() == share.to_bits() => *count += 1,
-                _ => repeats.push((1, share)),
-            }
-        }
-        w.u32(repeats.len() as u32);
-        for (count, value) in repeats {
+        w.u32(shares.len() as u32);
+        for &(count, value) in shares {
             w.varint(count);
             w.f32(value);
         }
@@ -1056,15 +1071,9 @@ impl Landings {
             })
             .collect::<Option<Vec<_>>>()?;
         let total = end as usize;
-        let mut shares = Vec::with_capacity(total.min(r.0.len() / 6));
-        for _ in 0..count(r, 5)? {
-            let (repeat, value) = (r.varint()? as usize, r.f32()?);
-            if shares.len() + repeat > total {
-                return None;
-            }
-            shares.extend(std::iter::repeat_n(value, repeat));
-        }
-        if shares.len() != total {
+        let shares = (0..count(r, 5)?).map(|_| Some((r.varint()?, r.f32()?))).collect::<Option<Vec<_>>>()?;
+        // A count past the landings is refused before points are read for it.
+        if shares.iter().try_fold(0usize, |sum, &(count, _)| sum.checked_add(count as usize)).is_none_or(|sum| sum != total) {
             return None;
         }
         let mut points = Vec::with_capacity(total);

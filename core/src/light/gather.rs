@@ -561,7 +561,7 @@ impl LightModel {
                 && (0..traced.len() as u32).all(|side| !traced[side as usize] || model.may_be_sunlit(side) == b.may_be_sunlit(side))
         };
         if let Some(b) = beside.filter(|b| same_sunlit_sides(b)) {
-            (model.sensors, model.open_sensors) = (b.sensors.clone(), b.open_sensors.clone());
+            (model.sensors, model.open_sensors, model.sensors_of) = (b.sensors.clone(), b.open_sensors.clone(), b.cache_key.get().copied());
         } else {
             let sensors = model.scene.sensors.clone();
             let traced = par_map(model.settings.threads, sensors.len(), |i| {

@@ -140,6 +140,10 @@ pub struct LightModel {
     /// one refines where they are the same ([`cache::precompute_cached_beside`]).
     side_gathers: Vec<Arc<Gather>>,
     sensors: Arc<Vec<SensorGeometry>>,
+    /// The [`cache::key`] of the model whose `sensors` these are, when they
+    /// are shared with it (a picture's model beside the settings' own): its
+    /// cache file names that model instead of holding them again.
+    sensors_of: Option<u64>,
     /// Per patch side, whether the sun may reach it without crossing a
     /// window: its space has an opening to the open sky
     /// ([`openings::Spaces`]).
@@ -323,6 +327,7 @@ impl LightModel {
             surfaces,
             side_gathers: Vec::new(),
             sensors: Arc::default(),
+            sensors_of: None,
             open_sides: Vec::new(),
             open_sensors: Vec::new(),
             cache_key: std::sync::OnceLock::new(),

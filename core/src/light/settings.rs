@@ -77,7 +77,8 @@ pub struct LightSettings {
 /// Hemisphere rays per patch side times patches that
 /// [`LightSettings::for_display`] spends at most: 8× the default up to 6,250
 /// patches, 2× on a 23,000-patch house, the default on the 29,000-patch
-/// furnished floor of offices.
+/// furnished floor of offices, and past 50,000 patches, where even the
+/// default rays on every side would overspend it, the settings as they are.
 const DISPLAY_PATCH_RAYS: usize = 12_800_000;
 
 /// The most [`LightSettings::for_display`] multiplies the default patch rays by.
@@ -123,9 +124,17 @@ impl LightSettings {
     /// 4.0 s on 2 cores and a relight from 16 to 25 ms. Sensors and annual
     /// studies keep the settings as they are (a sensor's own rays carry its
     /// accuracy). Every side a picture shows keeps all its rays
-    /// ([`Self::unseen_ray_share`]).
+    /// ([`Self::unseen_ray_share`]), unless the default rays on every side
+    /// are past the budget: a model that large keeps the settings, as a
+    /// second model of it beside the first would cost more than it smooths
+    /// (Revit's Office_A, 121,077 patches and 10,244 sensors: a cold view
+    /// traced every sensor again, with every side's rays, and peaked at
+    /// 2.98 GB).
     pub fn for_display(self, patches: usize) -> Self {
         let default = Self::default().rays_per_patch;
+        if patches.saturating_mul(default) > DISPLAY_PATCH_RAYS {
+            return self;
+        }
         let wanted = (DISPLAY_PATCH_RAYS / patches.max(1)).clamp(default, DISPLAY_MAX_FACTOR * default);
         Self { unseen_ray_share: 1.0, ..self.with_more_patch_rays((wanted / self.rays_per_patch.max(1)).max(1)) }
     }
@@ -170,6 +179,8 @@ mod tests {
         assert_eq!(factor(base.for_display(6_250)), 8);
         assert_eq!(factor(base.for_display(12_500)), 4);
         assert_eq!(factor(base.for_display(29_442)), 1, "furnished floor of offices");
+        assert_eq!(base.for_display(29_442).unseen_ray_share, 1.0, "its unseen sides smoothed");
+        assert_eq!(base.for_display(121_077), base, "Office_A: past the budget, the settings' own");
         let display = base.for_display(3_054);
         assert_eq!(display.window_rays_per_patch, 8 * base.window_rays_per_patch);
         assert_eq!(display.rays_per_sensor, base.rays_per_sensor, "a sensor's rays are its own");
