@@ -149,8 +149,8 @@ impl LightModel {
     /// gathers is every patch side's reflectance, so a model whose panels
     /// were swapped ([`Self::set_panel_model`]) finds its own.
     pub fn sensor_coefficients_cached(&self, dir: &Path) -> (SensorCoefficients, CacheOutcome) {
-        let (sensors, sides, slots) = (self.sensors.len(), self.side_gathers.len(), self.radiance_slots().len());
-        if (slots + sides) * sensors * size_of::<f32>() > MAX_CACHED_BYTES {
+        let sides = self.side_gathers.len();
+        if self.coefficient_bytes() > MAX_CACHED_BYTES {
             return (self.sensor_coefficients(), CacheOutcome::Skipped("too large to keep".into()));
         }
         let mut hash = StableHash::new();
@@ -171,6 +171,14 @@ impl LightModel {
             SensorCoefficients::save,
         );
         stored.unwrap_or_else(|why| (self.sensor_coefficients(), CacheOutcome::Skipped(why)))
+    }
+
+    /// The bytes [`Self::sensor_coefficients`] holds: a number per sensor
+    /// and radiance slot, and per sensor and patch side. Dense, so a whole
+    /// building's grids on a fine model are many gigabytes (Revit's
+    /// Office_A, 10,244 sensors and 242,154 patch sides: 10.1 GB).
+    pub fn coefficient_bytes(&self) -> usize {
+        (self.radiance_slots().len() + self.side_gathers.len()) * self.sensors.len() * size_of::<f32>()
     }
 
     /// Column lists of the form factors: for side j, every (i, F_ij).

@@ -11,7 +11,7 @@ use crate::annual::{
     AnnualOptions, AnnualResult, HourlyReadings, Occupancy, ShadedModel, annual, missing_in_daylight_note, skipped_hours_note,
 };
 use crate::cli::CliError;
-use crate::cli::args::{Format, LightArgs, load_for_command, precompute_for_command, progress_bar};
+use crate::cli::args::{Format, LightArgs, load_for_command, precompute_for_command, progress_bar, warn_about_coefficients};
 use crate::light::cache;
 use crate::panel::PanelCatalog;
 use crate::report::{csv_field, json_string};
@@ -55,6 +55,7 @@ pub fn run(args: &AnnualArgs, panels: &PanelCatalog) -> Result<(), CliError> {
 
     let settings = args.light.settings();
     let model = precompute_for_command(scene.clone(), settings, args.light.no_cache)?;
+    warn_about_coefficients(&args.scene, &model);
     let shaded = |down: &[usize]| precompute_for_command(std::sync::Arc::new(scene.with_shades_down(down)), settings, args.light.no_cache);
     let shades: Option<ShadedModel> = (!scene.shades.is_empty() && !args.no_shades).then_some(&shaded);
     // The year's sun at the site: traced once, then from the cache for every

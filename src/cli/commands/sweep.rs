@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 
 use crate::annual::{Occupancy, YearSkies};
 use crate::cli::CliError;
-use crate::cli::args::{Format, LightArgs, SkyArgs, load_for_command, precompute_for_command, progress_bar, sky_for};
+use crate::cli::args::{
+    Format, LightArgs, SkyArgs, load_for_command, precompute_for_command, progress_bar, sky_for, warn_about_coefficients,
+};
 use crate::cli::sweep_table::{Row, SDA_ROW, Table, best, key_value};
 use crate::panel::PanelCatalog;
 use crate::report::{csv_field, json_string};
@@ -123,6 +125,7 @@ pub fn run(args: &SweepArgs, panels: &PanelCatalog) -> Result<(), CliError> {
         None => 0..grid.len(),
     };
     let mut model = precompute_for_command(scene.clone(), args.light.settings(), args.light.no_cache)?;
+    warn_about_coefficients(&args.scene, &model);
     let progress = progress_bar("sweeping");
     let outcomes = sweep(&mut model, &variation, &grid, range, &sensors, target, &|_, done| progress.set_position((done * 1000.0) as u64));
     progress.finish_and_clear();
