@@ -23,7 +23,10 @@ a sensor grid where the space fills its box, otherwise the grid's points
 over the space's floor, 0.3 m in from its edges too, as point sensors
 `<space>/<k>` (an L-shaped corridor's box reaches into the rooms beside it;
 a point 2 cm from a wall in the notch of such a space sees that wall as half
-its view, and refines the wall's patches around it to a few centimetres). The site's latitude and
+its view, and refines the wall's patches around it to a few centimetres).
+A model whose only slabs are stair landings (Revit's Office_A: an
+architect's export without the structure's slabs) is said to have no
+floors under its spaces. The site's latitude and
 longitude come from IfcSite when given there (0°, 0°, said so, where it gives
 none: give --latitude and --longitude), and without --timezone the
 standard time is that of the meridian nearest the longitude (said so: an
@@ -301,6 +304,11 @@ def main():
         print("no IfcSpace with room for sensors: scene.toml has none; add [[sensor_grids]] or [[sensors]] to it", file=sys.stderr)
     if partial:
         print(f"{partial} spaces do not fill their box: point sensors over their floors instead of a grid", file=sys.stderr)
+    slabs = model.by_type("IfcSlab")
+    if used and all(s.PredefinedType == "LANDING" for s in slabs):
+        what = f"no IfcSlab but {len(slabs)} stair landings" if slabs else "no IfcSlab"
+        print(f"{what}: the spaces have no floors under them (an export without the structure's slabs?); "
+              "their sensors read the ground's light through the floor that is not there", file=sys.stderr)
     print(f"{len(vertices)} vertices, {sum(len(v) for v in faces.values())} triangles, {len(materials)} materials, "
           f"{len(used)} spaces with sensors -> {a.out}")
 
