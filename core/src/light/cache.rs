@@ -19,7 +19,7 @@ use glam::DVec3;
 
 use super::bvh::Tracer;
 use super::gather::{Gather, SensorGeometry};
-use super::landings::Landings;
+use super::landings::{Landings, RunPoints};
 use super::{LightModel, LightSettings};
 use crate::scene::{MaterialKind, Scene};
 use crate::sky::SkyPatches;
@@ -1034,7 +1034,7 @@ impl Landings {
     /// coordinate its points share (on a patch square to an axis, as most
     /// of a building's are, one of the three) written once.
     fn write(&self, w: &mut Writer) {
-        let (runs, shares, points) = self.parts();
+        let (runs, shares, run_points, coords) = self.parts();
         w.u32(runs.len() as u32);
         let (mut side, mut end) = (0, 0);
         for &(s, e) in runs {
@@ -1047,16 +1047,13 @@ impl Landings {
             w.varint(count);
             w.f32(value);
         }
-        let mut start = 0;
-        for &(_, end) in runs {
-            let run = &points[start..end as usize];
-            let shared: [bool; 3] = std::array::from_fn(|axis| run.iter().all(|p| p[axis] == run[0][axis]));
-            w.u8(shared.iter().enumerate().map(|(axis, &s)| u8::from(s) << axis).sum());
-            (0..3).filter(|&axis| shared[axis]).for_each(|axis| w.u16(run[0][axis]));
-            for point in run {
-                (0..3).filter(|&axis| !shared[axis]).for_each(|axis| w.u16(point[axis]));
-            }
-            start = end as usize;
+        let (mut start, mut offset) = (0, 0);
+        for (&(_, end), run) in runs.iter().zip(run_points) {
+            w.u8(run.shared);
+            (0..3).filter(|&axis| run.shared & (1 << axis) != 0).for_each(|axis| w.u16(run.first[axis]));
+            let own = (end - start) as usize * run.own_axes().count();
+            coords[offset..offset + own].iter().for_each(|&c| w.u16(c));
+            (start, offset) = (end, offset + own);
         }
     }
 
@@ -1076,27 +1073,23 @@ impl Landings {
         if shares.iter().try_fold(0usize, |sum, &(count, _)| sum.checked_add(count as usize)).is_none_or(|sum| sum != total) {
             return None;
         }
-        let mut points = Vec::with_capacity(total);
+        let (mut run_points, mut coords) = (Vec::with_capacity(runs.len()), Vec::with_capacity((2 * total).min(r.0.len() / 2)));
         let mut start = 0;
         for &(_, end) in &runs {
             if end < start || end as usize > total {
                 return None;
             }
-            let shared = r.u8().filter(|&bits| bits < 8)?;
-            let mut first = [0; 3];
-            for axis in (0..3).filter(|&axis| shared & (1 << axis) != 0) {
-                first[axis] = r.u16()?;
+            let mut run = RunPoints { shared: r.u8().filter(|&bits| bits < 8)?, first: [0; 3] };
+            for axis in (0..3).filter(|&axis| run.shared & (1 << axis) != 0) {
+                run.first[axis] = r.u16()?;
             }
-            for _ in start..end {
-                let mut point = first;
-                for axis in (0..3).filter(|&axis| shared & (1 << axis) == 0) {
-                    point[axis] = r.u16()?;
-                }
-                points.push(point);
+            for _ in 0..(end - start) as usize * run.own_axes().count() {
+                coords.push(r.u16()?);
             }
+            run_points.push(run);
             start = end;
         }
-        Self::from_parts(runs, shares, points)
+        Self::from_parts(runs, shares, run_points, coords)
     }
 }
 
@@ -1177,9 +1170,14 @@ mod tests {
             (7, 0.5, tilted(0.2, 0.1)),
             (7, 0.5, tilted(0.4, 0.5)),
         ];
-        let landings = Landings::new(raw, &boxes);
+        let landings = Landings::new(raw.clone(), &boxes);
         let sides: Vec<(u32, usize)> = landings.by_side().map(|(side, shares, _)| (side, shares.len())).collect();
         assert_eq!(sides, [(1, 1), (2, 1), (5, 2), (7, 2)]);
+        // Each point comes back on its grid, its shared axes held once.
+        let mut sorted = raw;
+        sorted.sort_by_key(|l| l.0);
+        let grid: Vec<[u16; 3]> = sorted.iter().map(|&(side, _, p)| boxes[side as usize / 2].grid(p)).collect();
+        assert_eq!(landings.by_side().flat_map(|(_, _, points)| points).collect::<Vec<_>>(), grid);
         let mut w = Writer::default();
         landings.write(&mut w);
         // Runs: count, then a side step and an end step each; shares: count,

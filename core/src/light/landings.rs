@@ -6,7 +6,9 @@
 //! few thousand per sensor), so they are kept small: a run per patch side,
 //! the landings' shares run-length coded (most are one ray's, 1/rays: as
 //! a float each, they were 148 MB of Revit's Office_A's 10,244 sensors), each
-//! point in 16 bits per axis of its patch's box ([`PatchBox`]). The point is stored so as soon as the ray
+//! point in 16 bits per axis of its patch's box ([`PatchBox`]), the axes a
+//! run's points share (on a patch square to an axis, as most of a
+//! building's are, one of the three) held once for the run. The point is stored so as soon as the ray
 //! lands, so a fresh gather and a cached one use the very same points.
 
 use glam::{DVec3, Vec3};
@@ -30,7 +32,7 @@ impl PatchBox {
     }
 
     /// `point` (in the box) on the grid.
-    fn grid(&self, point: DVec3) -> [u16; 3] {
+    pub(super) fn grid(&self, point: DVec3) -> [u16; 3] {
         let relative = (point.as_vec3() - self.lo) / self.step;
         let axis = |r: f32, step: f32| if step > 0.0 { r.round().clamp(0.0, Self::STEPS) as u16 } else { 0 };
         [axis(relative.x, self.step.x), axis(relative.y, self.step.y), axis(relative.z, self.step.z)]
@@ -66,8 +68,38 @@ pub(super) struct Landings {
     /// Each landing's share of the sensor's irradiance (the ray's weight
     /// over the rays traced), in landing order as repeats.
     shares: Vec<Repeat>,
-    /// Each landing's point on its side's [`PatchBox`] grid.
-    points: Vec<[u16; 3]>,
+    /// Per run, the grid coordinates its points share ([`RunPoints`]).
+    run_points: Vec<RunPoints>,
+    /// Each landing's other coordinates on its side's [`PatchBox`] grid,
+    /// in landing order, ascending axes.
+    coords: Vec<u16>,
+}
+
+/// What a run's points share: the axes (bit k for axis k) whose coordinate
+/// is the same for all of them, and those coordinates (0 on the others).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct RunPoints {
+    pub(super) shared: u8,
+    pub(super) first: [u16; 3],
+}
+
+impl RunPoints {
+    /// What `points` share.
+    fn of(points: &[[u16; 3]]) -> Self {
+        let mut run = Self::default();
+        for axis in 0..3 {
+            if points.iter().all(|p| p[axis] == points[0][axis]) {
+                run.shared |= 1 << axis;
+                run.first[axis] = points[0][axis];
+            }
+        }
+        run
+    }
+
+    /// The axes a point holds on its own, ascending.
+    pub(super) fn own_axes(self) -> impl Iterator<Item = usize> {
+        (0..3).filter(move |&axis| self.shared & (1 << axis) == 0)
+    }
 }
 
 impl Landings {
@@ -89,20 +121,30 @@ impl Landings {
                 _ => shares.push((1, share)),
             }
         }
-        let points = landings.iter().map(|&(side, _, point)| boxes[side as usize / 2].grid(point)).collect();
-        Self { runs, shares, points }
+        let points: Vec<[u16; 3]> = landings.iter().map(|&(side, _, point)| boxes[side as usize / 2].grid(point)).collect();
+        let (mut run_points, mut coords, mut start) = (Vec::with_capacity(runs.len()), Vec::new(), 0);
+        for &(_, end) in &runs {
+            let run = RunPoints::of(&points[start..end as usize]);
+            for point in &points[start..end as usize] {
+                coords.extend(run.own_axes().map(|axis| point[axis]));
+            }
+            run_points.push(run);
+            start = end as usize;
+        }
+        Self { runs, shares, run_points, coords }
     }
 
     /// The runs: each side with its landings' shares and grid points.
-    pub(super) fn by_side(&self) -> impl Iterator<Item = (u32, Shares<'_>, &[[u16; 3]])> {
+    pub(super) fn by_side(&self) -> impl Iterator<Item = (u32, Shares<'_>, Points<'_>)> {
         let mut next = Shares { repeats: &self.shares, used: 0, left: 0 };
-        let mut start = 0;
-        self.runs.iter().map(move |&(side, end)| {
-            let run = Shares { left: end - start, ..next.clone() };
+        let (mut start, mut offset) = (0, 0);
+        self.runs.iter().zip(&self.run_points).map(move |(&(side, end), &run)| {
+            let shares = Shares { left: end - start, ..next.clone() };
             next.advance(end - start);
-            let points = &self.points[start as usize..end as usize];
-            start = end;
-            (side, run, points)
+            let length = (end - start) as usize * run.own_axes().count();
+            let points = Points { run, coords: &self.coords[offset..offset + length], left: end - start };
+            (start, offset) = (end, offset + length);
+            (side, shares, points)
         })
     }
 
@@ -111,21 +153,56 @@ impl Landings {
         self.runs.iter().all(|r| r.0 < sides)
     }
 
-    /// Its runs (each side and where its landings end), shares (repeats)
-    /// and grid points, as the cache stores them.
-    pub(super) fn parts(&self) -> (&[Run], &[Repeat], &[[u16; 3]]) {
-        (&self.runs, &self.shares, &self.points)
+    /// Its runs (each side and where its landings end), shares (repeats),
+    /// what each run's points share and their other coordinates, as the
+    /// cache stores them.
+    pub(super) fn parts(&self) -> (&[Run], &[Repeat], &[RunPoints], &[u16]) {
+        (&self.runs, &self.shares, &self.run_points, &self.coords)
     }
 
     /// Landings from their parts; `None` unless the runs go up by side and
-    /// end, the last at the shares' (no repeat empty) and points' count.
-    pub(super) fn from_parts(runs: Vec<Run>, shares: Vec<Repeat>, points: Vec<[u16; 3]>) -> Option<Self> {
+    /// end, the last at the shares' count (no repeat empty), and the
+    /// coordinates are those the runs' points hold on their own.
+    pub(super) fn from_parts(runs: Vec<Run>, shares: Vec<Repeat>, run_points: Vec<RunPoints>, coords: Vec<u16>) -> Option<Self> {
         let ordered = runs.windows(2).all(|w| w[0].0 < w[1].0 && w[0].1 < w[1].1) && runs.first().is_none_or(|r| r.1 > 0);
+        let total = runs.last().map_or(0, |r| r.1 as usize);
         let shared = shares.iter().try_fold(0usize, |sum, &(count, _)| (count > 0).then(|| sum + count as usize));
-        let complete = runs.last().map_or(0, |r| r.1 as usize) == points.len() && shared == Some(points.len());
-        (ordered && complete).then_some(Self { runs, shares, points })
+        let starts = std::iter::once(0).chain(runs.iter().map(|r| r.1));
+        let own: usize =
+            starts.zip(&runs).zip(&run_points).map(|((start, &(_, end)), run)| (end - start) as usize * run.own_axes().count()).sum();
+        let complete = shared == Some(total) && run_points.len() == runs.len() && own == coords.len();
+        (ordered && complete && run_points.iter().all(|r| r.shared < 8)).then_some(Self { runs, shares, run_points, coords })
     }
 }
+
+/// The grid points of a run of landings, one by one off what the run's
+/// points share and their own coordinates.
+#[derive(Debug, Clone)]
+pub(super) struct Points<'a> {
+    run: RunPoints,
+    coords: &'a [u16],
+    /// How many points are left in the run.
+    left: u32,
+}
+
+impl Iterator for Points<'_> {
+    type Item = [u16; 3];
+
+    fn next(&mut self) -> Option<[u16; 3]> {
+        self.left = self.left.checked_sub(1)?;
+        let mut point = self.run.first;
+        let (these, rest) = self.coords.split_at_checked(self.run.own_axes().count())?;
+        self.run.own_axes().zip(these).for_each(|(axis, &c)| point[axis] = c);
+        self.coords = rest;
+        Some(point)
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        (self.left as usize, Some(self.left as usize))
+    }
+}
+
+impl ExactSizeIterator for Points<'_> {}
 
 /// The shares of a run of landings, one by one off the repeats.
 #[derive(Debug, Clone)]
@@ -184,8 +261,8 @@ mod tests {
         let points: Vec<DVec3> = (0..50).map(|k| on_it(0.009 * k as f64, 0.011 * k as f64)).collect();
         let landings = Landings::new(points.iter().map(|&p| (0, 0.25, p)).collect(), &boxes);
         let (_, shares, grid) = landings.by_side().next().unwrap();
-        assert_eq!(shares.len(), 50);
-        for (&point, &q) in points.iter().zip(grid) {
+        assert_eq!((shares.len(), grid.len()), (50, 50));
+        for (&point, q) in points.iter().zip(grid) {
             let back = boxes[0].point(q, normal);
             let above = (back - point).dot(normal);
             assert!(above > 0.0 && above < 2e-4, "{above}");

@@ -376,7 +376,7 @@ impl LightModel {
             let Some(reach) = reach.get(side as usize) else { continue };
             let Some(rho) = self.side_reflectance(side as usize) else { continue };
             let (normal, patch_box) = (self.side_normal(side), &self.patch_boxes[side as usize / 2]);
-            for (share, &grid) in shares.zip(points) {
+            for (share, grid) in shares.zip(points) {
                 let point = patch_box.point(grid, normal);
                 let e = self.reaching_irradiance(reach, point, normal, beams);
                 if e > 0.0 {
