@@ -315,11 +315,8 @@ pub fn through_cache<T>(
     let Some(dir) = dir else {
         return Ok((compute()?, CacheOutcome::Skipped("disabled".into())));
     };
-    let path = file_path(dir, name);
-    // Every start tidies: temporary files of processes killed mid-write
-    // go, and the folder keeps to its bound.
-    tidy(dir, &path, size_limit());
-    let rebuilt = match StreamedReader::open(&path, key) {
+    let (path, found) = open_streamed_entry(dir, name, key);
+    let rebuilt = match found {
         None => None,
         Some(Ok(file)) => {
             let mut blocks = Blocks { file, offset: 0 };
@@ -336,17 +333,9 @@ pub fn through_cache<T>(
     let value = compute()?;
     let stored = StreamedWriter::create(&path, key).and_then(|mut out| {
         save(&value, &mut BlockWriter(&mut out))?;
-        out.finish()
+        out.finish().map(drop)
     });
-    if stored.is_ok() {
-        tidy(dir, &path, size_limit());
-    }
-    let outcome = match (stored, rebuilt) {
-        (Err(e), _) => CacheOutcome::Skipped(format!("cannot write {}: {e}", path.display())),
-        (Ok(_), Some(why)) => CacheOutcome::Rebuilt(path, why),
-        (Ok(_), None) => CacheOutcome::Stored(path),
-    };
-    Ok((value, outcome))
+    Ok((value, stored_outcome(dir, path, stored, rebuilt)))
 }
 
 /// A cache file's payload written as blocks, each its length and its bytes.
@@ -424,6 +413,14 @@ pub(crate) fn open_entry(dir: &Path, name: &str, key: u64) -> (PathBuf, Option<R
     (path, found)
 }
 
+/// [`open_entry`] for a file read in place ([`StreamedReader`]).
+fn open_streamed_entry(dir: &Path, name: &str, key: u64) -> (PathBuf, Option<Result<StreamedReader, String>>) {
+    let path = file_path(dir, name);
+    tidy(dir, &path, size_limit());
+    let found = StreamedReader::open(&path, key);
+    (path, found)
+}
+
 /// A cache file read whole and checked: it derefs to its payload.
 pub(crate) struct Payload(Vec<u8>);
 
@@ -445,6 +442,12 @@ pub(crate) fn store_entry(dir: &Path, path: PathBuf, key: u64, payload: &[u8], r
         write_file(&partial, payload, key)?;
         fs::rename(&partial, &path)
     });
+    stored_outcome(dir, path, stored, rebuilt)
+}
+
+/// What storing the file at `path` came to (`rebuilt`: why a file there
+/// was not used); the folder tidied to its bound once it is stored.
+fn stored_outcome(dir: &Path, path: PathBuf, stored: io::Result<()>, rebuilt: Option<String>) -> CacheOutcome {
     if stored.is_ok() {
         tidy(dir, &path, size_limit());
     }
@@ -468,9 +471,8 @@ pub(crate) fn through_streamed_cache<T>(
     load: impl Fn(StreamedReader) -> Result<T, String>,
     write: impl FnOnce(&mut StreamedWriter) -> io::Result<()>,
 ) -> Option<(T, CacheOutcome)> {
-    let path = file_path(dir, name);
-    tidy(dir, &path, size_limit());
-    let rebuilt = match StreamedReader::open(&path, key) {
+    let (path, found) = open_streamed_entry(dir, name, key);
+    let rebuilt = match found {
         None => None,
         Some(Ok(file)) => match load(file) {
             Ok(value) => {
@@ -484,12 +486,7 @@ pub(crate) fn through_streamed_cache<T>(
     let mut out = StreamedWriter::create(&path, key).ok()?;
     write(&mut out).ok()?;
     let value = load(out.finish().ok()?).ok()?;
-    tidy(dir, &path, size_limit());
-    let outcome = match rebuilt {
-        Some(why) => CacheOutcome::Rebuilt(path, why),
-        None => CacheOutcome::Stored(path),
-    };
-    Some((value, outcome))
+    Some((value, stored_outcome(dir, path, Ok(()), rebuilt)))
 }
 
 /// Side gathers per block of a light file (a few MB on a large model).
@@ -1034,7 +1031,7 @@ impl Landings {
     /// coordinate its points share (on a patch square to an axis, as most
     /// of a building's are, one of the three) written once.
     fn write(&self, w: &mut Writer) {
-        let (runs, shares, run_points, coords) = self.parts();
+        let (runs, shares) = self.parts();
         w.u32(runs.len() as u32);
         let (mut side, mut end) = (0, 0);
         for &(s, e) in runs {
@@ -1047,13 +1044,10 @@ impl Landings {
             w.varint(count);
             w.f32(value);
         }
-        let (mut start, mut offset) = (0, 0);
-        for (&(_, end), run) in runs.iter().zip(run_points) {
+        for (run, coords) in self.run_coordinates() {
             w.u8(run.shared);
             (0..3).filter(|&axis| run.shared & (1 << axis) != 0).for_each(|axis| w.u16(run.first[axis]));
-            let own = (end - start) as usize * run.own_axes().count();
-            coords[offset..offset + own].iter().for_each(|&c| w.u16(c));
-            (start, offset) = (end, offset + own);
+            coords.iter().for_each(|&c| w.u16(c));
         }
     }
 

@@ -8,8 +8,9 @@
 //! a float each, they were 148 MB of Revit's Office_A's 10,244 sensors), each
 //! point in 16 bits per axis of its patch's box ([`PatchBox`]), the axes a
 //! run's points share (on a patch square to an axis, as most of a
-//! building's are, one of the three) held once for the run. The point is stored so as soon as the ray
-//! lands, so a fresh gather and a cached one use the very same points.
+//! building's are, one of the three) held once for the run. The point is
+//! stored so as soon as the ray lands, so a fresh gather and a cached one
+//! use the very same points.
 
 use glam::{DVec3, Vec3};
 
@@ -137,14 +138,24 @@ impl Landings {
     /// The runs: each side with its landings' shares and grid points.
     pub(super) fn by_side(&self) -> impl Iterator<Item = (u32, Shares<'_>, Points<'_>)> {
         let mut next = Shares { repeats: &self.shares, used: 0, left: 0 };
-        let (mut start, mut offset) = (0, 0);
-        self.runs.iter().zip(&self.run_points).map(move |(&(side, end), &run)| {
-            let shares = Shares { left: end - start, ..next.clone() };
-            next.advance(end - start);
-            let length = (end - start) as usize * run.own_axes().count();
-            let points = Points { run, coords: &self.coords[offset..offset + length], left: end - start };
-            (start, offset) = (end, offset + length);
-            (side, shares, points)
+        let lengths =
+            std::iter::once(0).chain(self.runs.iter().map(|r| r.1)).zip(&self.runs).map(|(start, &(side, end))| (side, end - start));
+        lengths.zip(self.run_coordinates()).map(move |((side, length), (run, coords))| {
+            let shares = Shares { left: length, ..next.clone() };
+            next.advance(length);
+            (side, shares, Points { run, coords, left: length })
+        })
+    }
+
+    /// Per run, what its points share and their own coordinates (as the
+    /// cache stores them).
+    pub(super) fn run_coordinates(&self) -> impl Iterator<Item = (RunPoints, &[u16])> {
+        let mut rest = &self.coords[..];
+        let starts = std::iter::once(0).chain(self.runs.iter().map(|r| r.1));
+        starts.zip(&self.runs).zip(&self.run_points).map(move |((start, &(_, end)), &run)| {
+            let (own, after) = rest.split_at((end - start) as usize * run.own_axes().count());
+            rest = after;
+            (run, own)
         })
     }
 
@@ -153,11 +164,11 @@ impl Landings {
         self.runs.iter().all(|r| r.0 < sides)
     }
 
-    /// Its runs (each side and where its landings end), shares (repeats),
-    /// what each run's points share and their other coordinates, as the
-    /// cache stores them.
-    pub(super) fn parts(&self) -> (&[Run], &[Repeat], &[RunPoints], &[u16]) {
-        (&self.runs, &self.shares, &self.run_points, &self.coords)
+    /// Its runs (each side and where its landings end) and shares
+    /// (repeats), as the cache stores them; the points are
+    /// [`Self::run_coordinates`].
+    pub(super) fn parts(&self) -> (&[Run], &[Repeat]) {
+        (&self.runs, &self.shares)
     }
 
     /// Landings from their parts; `None` unless the runs go up by side and
