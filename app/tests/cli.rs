@@ -103,6 +103,14 @@ fn info_summarises_each_bundled_scene() {
         .and_then(|n| n.parse().ok())
         .expect("patch line");
     assert!(patches > 400, "{out}");
+    // Where the patches go: the 4 × 6 × 3 m room's floor and ceiling face
+    // up and down, its walls sideways, and every patch has a width class.
+    let facing = out.lines().find_map(|l| l.strip_prefix("  facing   ")).expect("facing line");
+    assert!(facing.contains(" (24 m²), down ") && facing.ends_with(" (60 m²)"), "{out}");
+    let counted: usize = (out.lines().find_map(|l| l.strip_prefix("  wide     ")).expect("width line").split(", "))
+        .map(|class| class.split_whitespace().rev().nth(2).and_then(|n| n.parse::<usize>().ok()).expect("a count"))
+        .sum();
+    assert_eq!(counted, patches, "{out}");
     let Run { code, out, .. } = heliodon(&["info", "assets/scenes/office/scene.toml"], &scratch());
     assert_eq!(code, 0);
     assert!(out.contains("windows    12, 24.88 m² in all") && out.contains("facing W (azimuth 270°)"), "{out}");

@@ -67,6 +67,7 @@ pub fn info(scene: &Scene, windows: &WindowGroups) -> String {
         scene.patch_size,
         scene.patches.triangles.len()
     );
+    let _ = write!(out, "{}", patch_breakdown(scene));
     let _ = writeln!(out, "materials  {}", scene.materials.len());
     for kind in ["diffuse", "glass", "panel"] {
         let of_kind: Vec<String> = scene
@@ -128,4 +129,35 @@ pub fn info(scene: &Scene, windows: &WindowGroups) -> String {
         let _ = writeln!(out, "cameras    {}", names.join(", "));
     }
     out
+}
+
+/// Where the patches go: how many face up, down and sideways, and how
+/// wide they are against `patch_size` (the side of a square of their
+/// area), with the area each class covers: what to look at when a model
+/// has more patches than expected.
+fn patch_breakdown(scene: &Scene) -> String {
+    const WIDTHS: [(&str, f32); 4] = [("finest", 1.0), ("to 2×", 2.0), ("to 4×", 4.0), ("wider", f32::INFINITY)];
+    let mut by_width = [(0usize, 0f64); 4];
+    let mut by_facing = [(0usize, 0f64); 3];
+    for patch in &scene.patches.patches {
+        let width = patch.area.sqrt() / scene.patch_size;
+        // A finest cell cut by an edge is narrower; rounding lets a whole one count as finest.
+        let class = WIDTHS.iter().position(|&(_, most)| width <= most * 1.001).unwrap_or(WIDTHS.len() - 1);
+        let facing = if patch.normal.z > 0.7 {
+            0
+        } else if patch.normal.z < -0.7 {
+            1
+        } else {
+            2
+        };
+        for (count, area) in [&mut by_width[class], &mut by_facing[facing]] {
+            *count += 1;
+            *area += f64::from(patch.area);
+        }
+    }
+    let list = |names: &[&str], classes: &[(usize, f64)]| -> String {
+        names.iter().zip(classes).map(|(name, (count, area))| format!("{name} {count} ({area:.0} m²)")).collect::<Vec<_>>().join(", ")
+    };
+    let widths: Vec<&str> = WIDTHS.iter().map(|(name, _)| *name).collect();
+    format!("  wide     {}\n  facing   {}\n", list(&widths, &by_width), list(&["up", "down", "sideways"], &by_facing))
 }
