@@ -125,16 +125,16 @@ const LARGE_COEFFICIENTS: usize = 2 << 30;
 
 /// Warns (one line) when the sensor coefficients a year or a sweep solves
 /// take more than [`LARGE_COEFFICIENTS`]: they are dense, a number per
-/// sensor and patch side, and a whole building's grids on a fine model
-/// take gigabytes, which is better said before than found out.
+/// sensor and radiance slot (sky bin, straight or through glass or a
+/// panel), and tens of thousands of sensors take gigabytes, which is
+/// better said before than found out.
 pub fn warn_about_coefficients(scene_path: &Path, model: &LightModel) {
     let bytes = model.coefficient_bytes();
     if bytes > LARGE_COEFFICIENTS {
         eprintln!(
-            "warning: {}: the coefficients of {} sensors over {} patch sides take about {:.1} GB of memory (a number per sensor and side): the sensors of fewer rooms, or a coarser lighting.patch_size, take less",
+            "warning: {}: the coefficients of {} sensors take about {:.1} GB of memory (a number per sensor and sky bin): the sensors of fewer rooms take less",
             scene_path.display(),
             model.scene.sensors.len(),
-            model.scene.patches.patches.len() * 2,
             bytes as f64 / 1e9
         );
     }

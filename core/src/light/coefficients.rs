@@ -66,6 +66,13 @@ const IMPORTANCE_FLOOR: f32 = 1e-6;
 /// The most coefficients kept in the light cache, bytes: past it (a grid of
 /// tens of thousands of sensors) they are solved each run instead.
 const MAX_CACHED_BYTES: usize = 256 << 20;
+/// The most bytes the sun's later-bounce coefficients are held in, a number
+/// per sensor and patch side: past it (a whole building's grids) the sun's
+/// light is folded through the adjoints solved again instead
+/// ([`SensorCoefficients::add_later_bounces`]), for what the sun lights
+/// then, and memory follows the sensors, not sensors × sides (Revit's
+/// Office_A, 10,244 sensors and 242,154 sides: 9.9 GB).
+const MAX_SUN_ROW_BYTES: usize = 512 << 20;
 /// Coefficients per block of their cache file (4 MB).
 const VALUES_PER_BLOCK: usize = 1 << 20;
 
@@ -82,8 +89,11 @@ pub struct SensorCoefficients {
     /// Interreflected lux per unit radiance (W/m²/sr) of each slot, `[slot][sensor]`.
     pub(super) sky: Vec<f32>,
     /// Interreflected lux per W/m² of sun beams on each side, beyond the
-    /// first bounce, `[side][sensor]`.
-    sun: Vec<f32>,
+    /// first bounce, `[side][sensor]`; `None` past [`MAX_SUN_ROW_BYTES`].
+    sun: Option<Vec<f32>>,
+    /// Per side, the largest of its sun coefficients: the most a W/m² of
+    /// sun on it changes any sensor's later bounces.
+    importance: Vec<f64>,
     /// Sides some sensor sees, directly or by interreflection: the sun
     /// elsewhere (on a roof, say) changes no reading and is not traced.
     seen: Vec<bool>,
@@ -92,27 +102,32 @@ pub struct SensorCoefficients {
 }
 
 impl LightModel {
-    /// Solves every sensor's adjoint and folds it into coefficients.
+    /// Solves every sensor's adjoint and folds it into coefficients (the
+    /// sun's later bounces only where they fit, [`MAX_SUN_ROW_BYTES`]).
     pub fn sensor_coefficients(&self) -> SensorCoefficients {
+        self.solve_coefficients(self.sun_row_bytes() <= MAX_SUN_ROW_BYTES)
+    }
+
+    /// [`Self::sensor_coefficients`], with the sun's rows held or not.
+    fn solve_coefficients(&self, sun_rows: bool) -> SensorCoefficients {
         let sensors = self.sensors.len();
         let sides = self.side_gathers.len();
         let slots = self.radiance_slots();
-        let reflectance: Vec<[f32; 3]> = (0..sides).map(|side| self.side_reflectance(side).unwrap_or_default().map(|r| r as f32)).collect();
-        let transposed = self.transposed_form_factors();
         let mut sky = vec![0.0f32; slots.len() * sensors];
-        let mut sun = vec![0.0f32; sides * sensors];
+        let mut sun = sun_rows.then(|| vec![0.0f32; sides * sensors]);
+        let mut importance = vec![0.0f64; sides];
         let mut seen = vec![false; sides];
-        let mut iterations = 0;
-        for first in (0..sensors).step_by(BLOCK) {
-            let block = first..(first + BLOCK).min(sensors);
-            let (weights, n) = self.adjoint_block(block.clone(), &transposed, &reflectance);
-            iterations = iterations.max(n);
-            let width = block.len();
+        let iterations = self.adjoint_blocks(|block, weights| {
+            let (first, width) = (block.start, block.len());
             for side in 0..sides {
                 let row = &weights[side * width..(side + 1) * width];
                 let gather = &self.side_gathers[side];
                 for (k, &(u, beam)) in row.iter().enumerate() {
-                    sun[side * sensors + first + k] = (beam * LUMINOUS_EFFICACY) as f32;
+                    let coefficient = sun_coefficient(beam);
+                    importance[side] = importance[side].max(f64::from(coefficient));
+                    if let Some(sun) = &mut sun {
+                        sun[side * sensors + first + k] = coefficient;
+                    }
                     if u == 0.0 {
                         continue;
                     }
@@ -127,8 +142,25 @@ impl LightModel {
                     }
                 }
             }
+        });
+        SensorCoefficients { sensors, slots, sky, sun, importance, seen, iterations }
+    }
+
+    /// Solves the sensors' adjoints [`BLOCK`] sensors at a time, handing
+    /// each block's weights ([`Self::adjoint_block`]) to `each`; the most
+    /// iterations a block took.
+    fn adjoint_blocks(&self, mut each: impl FnMut(std::ops::Range<usize>, &[(f64, f64)])) -> usize {
+        let sides = self.side_gathers.len();
+        let reflectance: Vec<[f32; 3]> = (0..sides).map(|side| self.side_reflectance(side).unwrap_or_default().map(|r| r as f32)).collect();
+        let transposed = self.transposed_form_factors();
+        let mut iterations = 0;
+        for first in (0..self.sensors.len()).step_by(BLOCK) {
+            let block = first..(first + BLOCK).min(self.sensors.len());
+            let (weights, n) = self.adjoint_block(block.clone(), &transposed, &reflectance);
+            iterations = iterations.max(n);
+            each(block, &weights);
         }
-        SensorCoefficients { sensors, slots, sky, sun, seen, iterations }
+        iterations
     }
 
     /// How many of the sensors' rays land on each side: where the sun's
@@ -150,7 +182,7 @@ impl LightModel {
     /// were swapped ([`Self::set_panel_model`]) finds its own.
     pub fn sensor_coefficients_cached(&self, dir: &Path) -> (SensorCoefficients, CacheOutcome) {
         let sides = self.side_gathers.len();
-        if self.coefficient_bytes() > MAX_CACHED_BYTES {
+        if self.coefficient_bytes() > MAX_CACHED_BYTES || self.sun_row_bytes() > MAX_SUN_ROW_BYTES {
             return (self.sensor_coefficients(), CacheOutcome::Skipped("too large to keep".into()));
         }
         let mut hash = StableHash::new();
@@ -174,11 +206,17 @@ impl LightModel {
     }
 
     /// The bytes [`Self::sensor_coefficients`] holds: a number per sensor
-    /// and radiance slot, and per sensor and patch side. Dense, so a whole
-    /// building's grids on a fine model are many gigabytes (Revit's
-    /// Office_A, 10,244 sensors and 242,154 patch sides: 10.1 GB).
+    /// and radiance slot, and per sensor and patch side where those fit
+    /// ([`MAX_SUN_ROW_BYTES`]).
     pub fn coefficient_bytes(&self) -> usize {
-        (self.radiance_slots().len() + self.side_gathers.len()) * self.sensors.len() * size_of::<f32>()
+        let sun = if self.sun_row_bytes() <= MAX_SUN_ROW_BYTES { self.sun_row_bytes() } else { 0 };
+        self.radiance_slots().len() * self.sensors.len() * size_of::<f32>() + sun
+    }
+
+    /// The bytes of the sun's later-bounce coefficients, a number per
+    /// sensor and patch side.
+    fn sun_row_bytes(&self) -> usize {
+        self.side_gathers.len() * self.sensors.len() * size_of::<f32>()
     }
 
     /// Column lists of the form factors: for side j, every (i, F_ij).
@@ -344,7 +382,8 @@ impl SensorCoefficients {
             w.u32(self.sensors as u32);
             w.u32(self.iterations as u32);
         })?;
-        for values in [&self.sky, &self.sun] {
+        // Only coefficients with their sun rows are kept (`sensor_coefficients_cached`).
+        for values in [&self.sky[..], self.sun.as_deref().unwrap_or_default()] {
             out.items(values, VALUES_PER_BLOCK, |w, &v| w.f32(v))?;
         }
         out.items(&self.seen, VALUES_PER_BLOCK, |w, &seen| w.u32(u32::from(seen)))
@@ -363,7 +402,9 @@ impl SensorCoefficients {
         let sky = blocks.items(slots.len() * sensors, |r| r.f32())?;
         let sun = blocks.items(sides * sensors, |r| r.f32())?;
         let seen = blocks.items(sides, |r| r.u32().map(|v| v != 0))?;
-        r.is_empty().then_some(Self { sensors, slots, sky, sun, seen, iterations })
+        let row = |side: usize| &sun[side * sensors..(side + 1) * sensors];
+        let importance = (0..sides).map(|side| row(side).iter().map(|&c| f64::from(c)).fold(0.0, f64::max)).collect();
+        r.is_empty().then_some(Self { sensors, slots, sky, sun: Some(sun), importance, seen, iterations })
     }
 
     /// Every sensor's reading under `sky` (`threads` as [`par_map`]): equal
@@ -433,8 +474,9 @@ impl SensorCoefficients {
     /// sides some sensor sees and where the sensors' rays land.
     fn interreflected_sun(&self, model: &LightModel, beams: &[SunBeam], threads: Option<usize>) -> Vec<f64> {
         let sides_sun = model.sun_on_sides(beams, &|side| if self.seen[side] { model.sun_samples(side) } else { 0 }, true, threads);
-        let mut lux = self.first_bounce(model, beams, &sides_sun.reach, threads);
-        add_products(&mut lux, self.later_bounces(&sides_sun.irradiance));
+        let mut lux = [self.first_bounce(model, beams, &sides_sun.reach, threads)];
+        self.add_later_bounces(model, &mut lux, &[lit_sides(&sides_sun.irradiance)]);
+        let [lux] = lux;
         lux
     }
 
@@ -454,10 +496,8 @@ impl SensorCoefficients {
     /// (office hours against `sensors`: max 1.57% where all samples gave
     /// 1.66%).
     pub(super) fn path_sun_samples(&self, full: usize) -> Vec<usize> {
-        let row = |side: usize| &self.sun[side * self.sensors..(side + 1) * self.sensors];
-        let importance: Vec<f64> = (0..self.seen.len()).map(|side| row(side).iter().map(|&c| f64::from(c)).fold(0.0, f64::max)).collect();
-        let enough = PATH_IMPORTANCE_SHARE * importance.iter().copied().fold(0.0, f64::max);
-        importance
+        let enough = PATH_IMPORTANCE_SHARE * self.importance.iter().copied().fold(0.0, f64::max);
+        self.importance
             .iter()
             .zip(&self.seen)
             .map(|(&importance, &seen)| match seen {
@@ -468,11 +508,56 @@ impl SensorCoefficients {
             .collect()
     }
 
-    /// The terms of the beams' later bounces: each side's beam irradiance
-    /// with its row of coefficients.
-    pub(super) fn later_bounces<'s>(&'s self, beams_on_sides: &'s [f64]) -> impl Iterator<Item = (&'s f64, &'s [f32])> {
-        beams_on_sides.iter().zip(self.sun.chunks_exact(self.sensors.max(1)))
+    /// Adds each source's light beyond its first bounce at every sensor to
+    /// its sum, lux; a source is the beams' irradiance on the sides they
+    /// light ([`lit_sides`]). With the sun rows held, their products; else
+    /// the adjoints are solved again and each block's weights folded with
+    /// every source at once, the same sums bit for bit: a year's sun path
+    /// is one more solve, not a number per sensor and side.
+    pub(super) fn add_later_bounces(&self, model: &LightModel, sums: &mut [Vec<f64>], sources: &[LitSides]) {
+        if self.sensors == 0 {
+            return;
+        }
+        let Some(rows) = &self.sun else {
+            model.adjoint_blocks(|block, weights| {
+                let width = block.len();
+                let before: &[Vec<f64>] = sums;
+                let parts = par_map(model.settings.threads, sources.len(), |s| {
+                    let mut part = before[s][block.clone()].to_vec();
+                    for &(side, irradiance) in &sources[s] {
+                        let row = &weights[side as usize * width..(side as usize + 1) * width];
+                        for (sum, &(_, beam)) in part.iter_mut().zip(row) {
+                            *sum += irradiance * f64::from(sun_coefficient(beam));
+                        }
+                    }
+                    part
+                });
+                for (sum, part) in sums.iter_mut().zip(parts) {
+                    sum[block.clone()].copy_from_slice(&part);
+                }
+            });
+            return;
+        };
+        for (sum, source) in sums.iter_mut().zip(sources) {
+            let terms = source.iter().map(|(side, irradiance)| (irradiance, &rows[*side as usize * self.sensors..][..self.sensors]));
+            add_products(sum, terms);
+        }
     }
+}
+
+/// A sun coefficient as held: lux per W/m² of beams on a side, from its
+/// adjoint's beam weight.
+fn sun_coefficient(beam: f64) -> f32 {
+    (beam * LUMINOUS_EFFICACY) as f32
+}
+
+/// The sides a sun lights and its beams' irradiance on each, W/m², in
+/// order: a source of [`SensorCoefficients::add_later_bounces`].
+pub(super) type LitSides = Vec<(u32, f64)>;
+
+/// The sides `irradiance` (per side) lights, as [`LitSides`].
+pub(super) fn lit_sides(irradiance: &[f64]) -> LitSides {
+    irradiance.iter().enumerate().filter(|(_, e)| **e != 0.0).map(|(side, &e)| (side as u32, e)).collect()
 }
 
 /// `sum` += Σ source × row, over (source, row of coefficients per sensor).
@@ -555,17 +640,12 @@ impl SunPath {
         let needed: Vec<(i32, i32)> =
             suns.iter().flat_map(|&sun| path.cell(sun).0).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
         let samples = coefficients.path_sun_samples(model.settings.sun_samples_per_patch);
-        let values = par_map(threads, needed.len(), |k| {
-            let direction = path.direction(needed[k]);
-            let sun = SunSource::unit(direction);
-            let beams = model.sun_beams(&sun);
-            let mut lux = vec![0.0; model.sensors.len()];
-            add_products(
-                &mut lux,
-                coefficients.later_bounces(&model.sun_on_sides(&beams, &|side| samples[side], false, Some(1)).irradiance),
-            );
-            lux
+        let sources = par_map(threads, needed.len(), |k| {
+            let beams = model.sun_beams(&SunSource::unit(path.direction(needed[k])));
+            lit_sides(&model.sun_on_sides(&beams, &|side| samples[side], false, Some(1)).irradiance)
         });
+        let mut values = vec![vec![0.0; model.sensors.len()]; needed.len()];
+        coefficients.add_later_bounces(model, &mut values, &sources);
         path.nodes = needed.into_iter().zip(values).collect();
         path
     }
@@ -620,7 +700,38 @@ const MIN_SUN_HEIGHT: f64 = 0.01;
 
 #[cfg(test)]
 mod tests {
+    use std::sync::Arc;
+
     use super::*;
+    use crate::light::LightSettings;
+    use crate::panel::PanelCatalog;
+    use crate::sky::SkySpec;
+    use crate::time::LocalDateTime;
+
+    /// Past the memory they may take, the sun's later bounces are folded
+    /// through the adjoints solved again: the readings under a clear sky
+    /// and a sun path's nodes are those of the coefficients held, bit for
+    /// bit, and the sun's later bounces are there to compare.
+    #[test]
+    fn folded_sun_coefficients_read_as_held_ones() {
+        let scene = crate::scene::load_scene(&crate::bundled_scene("test_room"), &PanelCatalog::new()).unwrap().scene;
+        let site = scene.site;
+        let model = LightModel::precompute(Arc::new(scene), LightSettings::default()).unwrap();
+        let (held, folded) = (model.solve_coefficients(true), model.solve_coefficients(false));
+        assert!(held.sun.is_some() && folded.sun.is_none());
+        assert_eq!((&held.sky, &held.importance, &held.seen), (&folded.sky, &folded.importance, &folded.seen));
+        let when =
+            LocalDateTime { date: crate::time::Date::new(2026, 3, 21).unwrap(), time: crate::time::TimeOfDay::from_hours(10.0).unwrap() };
+        let sky = crate::sky::sky_at(&site, &SkySpec::Clear { turbidity: 2.45 }, &when).1.unwrap();
+        let sun = sky.sun_up().expect("the sun is up").direction;
+        let (a, b) = (held.readings(&model, &sky, None), folded.readings(&model, &sky, None));
+        assert_eq!(a, b);
+        let path = |coefficients| SunPath::new(&model, coefficients, &site, &[sun], None);
+        let (a, b) = (path(&held), path(&folded));
+        assert_eq!(a.nodes, b.nodes);
+        let later = a.later_bounces(sun);
+        assert!(later.iter().all(|&lux| lux > 0.0), "every sensor sees the sun's later bounces: {later:?}");
+    }
 
     /// Sun directions map to (declination, hour angle) and back, on a turned
     /// site too; the bilinear weights sum to 1.

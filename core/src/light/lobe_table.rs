@@ -28,7 +28,7 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
-use super::coefficients::{SunResponse, add_products};
+use super::coefficients::{LitSides, SunResponse, lit_sides};
 use super::{LightModel, SURFACE_OFFSET, SensorCoefficients, SunBeam, par_map};
 use crate::sky::LUMINOUS_EFFICACY;
 
@@ -120,16 +120,17 @@ impl LobeTable {
             .collect();
         let missing: Vec<Node> = missing.into_iter().collect();
         let samples = coefficients.path_sun_samples(model.settings.sun_samples_per_patch);
-        let lights = par_map(threads, missing.len(), |k| {
+        let traced = par_map(threads, missing.len(), |k| {
             let (beams, cos) = node_beam(model, missing[k]);
             let beams = [beams];
             let reach = model.sides_reach(&beams, Some(1));
             let first = coefficients.first_bounce(model, &beams, &reach, Some(1));
-            let mut later = vec![0.0; model.sensors.len()];
-            add_products(
-                &mut later,
-                coefficients.later_bounces(&model.sun_on_sides(&beams, &|side| samples[side], false, Some(1)).irradiance),
-            );
+            ((first, cos), lit_sides(&model.sun_on_sides(&beams, &|side| samples[side], false, Some(1)).irradiance))
+        });
+        let (firsts, sources): (Vec<(Vec<f64>, f64)>, Vec<LitSides>) = traced.into_iter().unzip();
+        let mut later = vec![vec![0.0; model.sensors.len()]; missing.len()];
+        coefficients.add_later_bounces(model, &mut later, &sources);
+        let lights = firsts.into_iter().zip(later).map(|((first, cos), later)| {
             let per_plane = |values: Vec<f64>| values.iter().map(|&v| (v / cos) as f32).collect();
             NodeLight { first: per_plane(first), later: per_plane(later) }
         });
