@@ -29,8 +29,10 @@
 //! bounce are still traced every hour ([`SensorCoefficients::readings_on_path`]).
 //!
 //! Cost: Jacobi iterations over the form factors for 3 × sensors right-hand
-//! sides at once (in blocks, so memory stays bounded); the coefficients
-//! hold sensors × slots and sensors × patch sides numbers.
+//! sides (1 × sensors where every side is grey), a block of sensors at once
+//! so memory stays bounded; the coefficients hold sensors × slots numbers,
+//! and sensors × patch sides numbers for the sun where those fit (past
+//! that the adjoints are solved again for the sun's light).
 
 use std::io;
 use std::path::Path;
@@ -153,10 +155,12 @@ impl LightModel {
         let sides = self.side_gathers.len();
         let reflectance: Vec<[f32; 3]> = (0..sides).map(|side| self.side_reflectance(side).unwrap_or_default().map(|r| r as f32)).collect();
         let transposed = self.transposed_form_factors();
+        // Grey sides pass every colour on alike: one channel stands for three.
+        let channels = if reflectance.iter().all(|[r, g, b]| r == g && g == b) { 1 } else { 3 };
         let mut iterations = 0;
         for first in (0..self.sensors.len()).step_by(BLOCK) {
             let block = first..(first + BLOCK).min(self.sensors.len());
-            let (weights, n) = self.adjoint_block(block.clone(), &transposed, &reflectance);
+            let (weights, n) = self.adjoint_block(block.clone(), &transposed, &reflectance, channels);
             iterations = iterations.max(n);
             each(block, &weights);
         }
@@ -232,21 +236,25 @@ impl LightModel {
 
     /// The adjoints of `block`'s sensors, luminous: per side and sensor,
     /// (Σ_c w_c u_c, Σ_c w_c (u_c − ρ_c g)), `[side][sensor]`, and the
-    /// iterations taken.
+    /// iterations taken. With `channels` 1 (every side grey) the one
+    /// channel iterated is each of the three's, number for number: the
+    /// same weights, bit for bit, in a third of the work (a model from
+    /// `tools/ifc_to_obj.py` is grey: a reflectance from each colour).
     fn adjoint_block(
         &self,
         block: std::ops::Range<usize>,
         columns: &[Vec<(u32, f32)>],
         reflectance: &[[f32; 3]],
+        channels: usize,
     ) -> (Vec<(f64, f64)>, usize) {
         let sides = columns.len();
-        let width = 3 * block.len();
+        let width = channels * block.len();
         // ρ g per side and right-hand side (sensor × channel): the source.
         let mut source = vec![0.0f32; sides * width];
         for (k, sensor) in block.clone().enumerate() {
             for &(j, f) in &self.sensors[sensor].gather.form_factors {
-                for c in 0..3 {
-                    source[j as usize * width + 3 * k + c] = f * reflectance[j as usize][c];
+                for c in 0..channels {
+                    source[j as usize * width + channels * k + c] = f * reflectance[j as usize][c];
                 }
             }
         }
@@ -278,7 +286,7 @@ impl LightModel {
                         }
                     }
                     let row = row_of(&source, j, width).iter().zip(&gathered).enumerate();
-                    out.extend(row.map(|(r, (o, g))| o + reflectance[j as usize][r % 3] * g));
+                    out.extend(row.map(|(r, (o, g))| o + reflectance[j as usize][r % channels] * g));
                 }
                 out
             })
@@ -313,7 +321,7 @@ impl LightModel {
             .flat_map(|j| {
                 let (u, source) = (&u[j * width..(j + 1) * width], &source[j * width..(j + 1) * width]);
                 (0..block.len()).map(move |k| {
-                    let channel = |v: &[f32]| [0, 1, 2].map(|c| f64::from(v[3 * k + c]));
+                    let channel = |v: &[f32]| [0, 1, 2].map(|c| f64::from(v[channels * k + c.min(channels - 1)]));
                     (luminous(channel(u)), luminous(channel(u)) - luminous(channel(source)))
                 })
             })
@@ -707,6 +715,24 @@ mod tests {
     use crate::panel::PanelCatalog;
     use crate::sky::SkySpec;
     use crate::time::LocalDateTime;
+
+    /// On a grey room (the test room's floor, walls and ceiling) one
+    /// channel iterated gives the three's weights bit for bit.
+    #[test]
+    fn a_grey_rooms_adjoints_take_one_channel_for_three() {
+        let scene = crate::scene::load_scene(&crate::bundled_scene("test_room"), &PanelCatalog::new()).unwrap().scene;
+        let model = LightModel::precompute(Arc::new(scene), LightSettings::default()).unwrap();
+        let sides = model.side_gathers.len();
+        let reflectance: Vec<[f32; 3]> =
+            (0..sides).map(|side| model.side_reflectance(side).unwrap_or_default().map(|r| r as f32)).collect();
+        assert!(reflectance.iter().all(|[r, g, b]| r == g && g == b) && reflectance.iter().any(|r| r[0] > 0.0));
+        let transposed = model.transposed_form_factors();
+        let block = 0..BLOCK.min(model.sensors.len());
+        let (one, three) =
+            (model.adjoint_block(block.clone(), &transposed, &reflectance, 1), model.adjoint_block(block, &transposed, &reflectance, 3));
+        assert_eq!(one, three);
+        assert!(one.0.iter().any(|&(u, beam)| u > 0.0 && beam > 0.0));
+    }
 
     /// Past the memory they may take, the sun's later bounces are folded
     /// through the adjoints solved again: the readings under a clear sky
