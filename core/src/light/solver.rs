@@ -40,6 +40,9 @@ pub struct Interreflection {
     pub indirect: Vec<[f64; 3]>,
     /// Irradiance below which a side counts as dark (for relative convergence).
     floor: f64,
+    /// Every side grey and the state too: the three channels are the same
+    /// numbers through every step, and one is iterated for them.
+    grey: bool,
     tolerance: f64,
     max_iterations: usize,
     /// Iterations done.
@@ -57,8 +60,10 @@ impl Interreflection {
     pub fn new(direct: Vec<f64>, reflectance: Vec<[f64; 3]>, warm: Option<Vec<[f64; 3]>>, tolerance: f64, max_iterations: usize) -> Self {
         let mean = direct.iter().sum::<f64>() / direct.len().max(1) as f64;
         let indirect = warm.filter(|w| w.len() == direct.len()).unwrap_or_else(|| vec![[0.0; 3]; direct.len()]);
+        let same = |[r, g, b]: &[f64; 3]| r == g && g == b;
         Self {
             floor: 1e-3 * mean.max(1e-12),
+            grey: reflectance.iter().all(same) && indirect.iter().all(same),
             direct,
             reflectance,
             indirect,
@@ -83,8 +88,17 @@ impl Interreflection {
         if self.converged {
             return true;
         }
-        let exitance = self.exitance(|j| self.direct[j]);
-        let next: Vec<[f64; 3]> = par_map(threads, self.direct.len(), |i| form_factor_product([0.0; 3], row(i), &exitance));
+        let next: Vec<[f64; 3]> = if self.grey {
+            // The first channel's products alone, in the same order: the same bits.
+            let exitance: Vec<f64> =
+                (0..self.direct.len()).map(|j| self.reflectance[j][0] * (self.direct[j] + self.indirect[j][0])).collect();
+            let next =
+                par_map(threads, self.direct.len(), |i| row(i).iter().fold(0.0, |sum, &(j, f)| sum + f64::from(f) * exitance[j as usize]));
+            next.into_iter().map(|e| [e; 3]).collect()
+        } else {
+            let exitance = self.exitance(|j| self.direct[j]);
+            par_map(threads, self.direct.len(), |i| form_factor_product([0.0; 3], row(i), &exitance))
+        };
         // The largest change relative to each side's own irradiance (dark
         // corners converge as well as sunlit floors).
         let change = next
@@ -278,6 +292,22 @@ mod tests {
             assert!((e1 + solver.indirect[0][c] - h1).abs() < 1e-6 * h1, "channel {c}: plate 1");
             assert!((solver.indirect[1][c] - h2).abs() < 1e-6 * h1, "channel {c}: plate 2");
         }
+    }
+
+    /// Grey sides iterated in one channel give the three channels' light
+    /// bit for bit, step for step.
+    #[test]
+    fn grey_sides_iterate_one_channel_for_three() {
+        let rows: Vec<Vec<(u32, f32)>> = (0..40u32).map(|i| vec![((i + 1) % 40, 0.3), ((i + 7) % 40, 0.2), ((i + 3) % 40, 0.1)]).collect();
+        let direct: Vec<f64> = (0..40).map(|i| f64::from(i % 5) * 50.0 + 0.1).collect();
+        let reflectance: Vec<[f64; 3]> = (0..40).map(|i| [0.2 + 0.015 * f64::from(i); 3]).collect();
+        let grey = Interreflection::new(direct, reflectance, None, 1e-10, 1000);
+        assert!(grey.grey);
+        let three = Interreflection { grey: false, ..grey.clone() };
+        let (grey, three) = (solve(grey, &rows), solve(three, &rows));
+        assert_eq!((grey.indirect, grey.iterations), (three.indirect, three.iterations));
+        assert!(three.iterations > 3);
+        assert!(!Interreflection::new(vec![1.0], vec![[0.5, 0.5, 0.4]], None, 1e-6, 10).grey, "a coloured side is not");
     }
 
     /// A warm start at the solution is already converged after one step,
