@@ -307,8 +307,7 @@ impl LightModel {
             .iter()
             .map(|patch| landings::PatchBox::around(&scene.patches.triangles[patch.triangle_indices()]))
             .collect();
-        let patches = &scene.patches.patches;
-        let ray_shares = par_map(settings.threads, patches.len(), |p| scene.patch_sizing.ray_share(patches[p].centroid));
+        let ray_shares = scene.patch_sizing.ray_shares(&scene.patches.patches, settings.threads);
         let mut model = Self {
             sky_bins: SkyPatches::reinhart(settings.sky_subdivision),
             patch_boxes,

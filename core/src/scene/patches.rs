@@ -415,6 +415,24 @@ impl PatchSizing {
         f64::from(self.finest / self.allowed(centroid, 0.0)).clamp(MIN_RAY_SHARE, 1.0)
     }
 
+    /// [`Self::ray_share`] of every patch (ordered by surface, as
+    /// [`PatchMesh`] holds them), each surface's asked of the sizing
+    /// [`Self::within`] the box of its patches' centroids: the same shares,
+    /// as that sizing keeps every box and sensor that can settle a place in
+    /// the box, without testing each patch against all of them (Revit's
+    /// Office_A, 121,077 patches and about 1,500 focus boxes: 16% of a warm
+    /// `sensors` run's samples).
+    pub fn ray_shares(&self, patches: &[Patch], threads: Option<usize>) -> Vec<f64> {
+        let surfaces: Vec<&[Patch]> = patches.chunk_by(|a, b| a.surface == b.surface).collect();
+        let shares = par_map(threads, surfaces.len(), |k| {
+            let region =
+                surfaces[k].iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p.centroid), hi.max(p.centroid)));
+            let local = self.within(region);
+            surfaces[k].iter().map(|p| local.ray_share(p.centroid)).collect::<Vec<_>>()
+        });
+        shares.concat()
+    }
+
     /// The side allowed at `centre`, for a cell of half-diagonal `reach`
     /// around it.
     fn allowed(&self, centre: Vec3, reach: f32) -> f32 {
@@ -1209,6 +1227,19 @@ mod tests {
         // Facing down, the floor is in their view.
         let seen = floor_of(Vec3::NEG_Z);
         assert!(seen.iter().all(|&(_, area)| (area - 0.25).abs() < 1e-4), "{seen:?}");
+    }
+
+    /// Every patch's ray share, asked surface by surface of the sizing
+    /// near it, is the one the whole sizing gives, on a model whose shares
+    /// vary (the office: sensors in its rooms, coarse on its roof and ground).
+    #[test]
+    fn ray_shares_by_surface_are_the_whole_sizings() {
+        let scene = crate::scene::load_scene(&crate::bundled_scene("office"), &crate::panel::PanelCatalog::new()).unwrap().scene;
+        let (sizing, patches) = (&scene.patch_sizing, &scene.patches.patches);
+        let one_by_one: Vec<f64> = patches.iter().map(|p| sizing.ray_share(p.centroid)).collect();
+        assert_eq!(sizing.ray_shares(patches, Some(2)), one_by_one);
+        let coarser = one_by_one.iter().filter(|&&s| s < 0.9).count();
+        assert!(coarser > 100 && one_by_one.contains(&1.0), "{coarser} of {} shares under 0.9", one_by_one.len());
     }
 
     /// A cell holding a quarter of its area of the surface or more stays a
