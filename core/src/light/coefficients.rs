@@ -107,7 +107,7 @@ impl LightModel {
     /// Solves every sensor's adjoint and folds it into coefficients (the
     /// sun's later bounces only where they fit, [`MAX_SUN_ROW_BYTES`]).
     pub fn sensor_coefficients(&self) -> SensorCoefficients {
-        self.solve_coefficients(self.sun_row_bytes() <= MAX_SUN_ROW_BYTES)
+        self.solve_coefficients(self.holds_sun_rows())
     }
 
     /// [`Self::sensor_coefficients`], with the sun's rows held or not.
@@ -186,7 +186,7 @@ impl LightModel {
     /// were swapped ([`Self::set_panel_model`]) finds its own.
     pub fn sensor_coefficients_cached(&self, dir: &Path) -> (SensorCoefficients, CacheOutcome) {
         let sides = self.side_gathers.len();
-        if self.coefficient_bytes() > MAX_CACHED_BYTES || self.sun_row_bytes() > MAX_SUN_ROW_BYTES {
+        if self.coefficient_bytes() > MAX_CACHED_BYTES || !self.holds_sun_rows() {
             return (self.sensor_coefficients(), CacheOutcome::Skipped("too large to keep".into()));
         }
         let mut hash = StableHash::new();
@@ -213,7 +213,7 @@ impl LightModel {
     /// and radiance slot, and per sensor and patch side where those fit
     /// ([`MAX_SUN_ROW_BYTES`]).
     pub fn coefficient_bytes(&self) -> usize {
-        let sun = if self.sun_row_bytes() <= MAX_SUN_ROW_BYTES { self.sun_row_bytes() } else { 0 };
+        let sun = if self.holds_sun_rows() { self.sun_row_bytes() } else { 0 };
         self.radiance_slots().len() * self.sensors.len() * size_of::<f32>() + sun
     }
 
@@ -221,6 +221,12 @@ impl LightModel {
     /// sensor and patch side.
     fn sun_row_bytes(&self) -> usize {
         self.side_gathers.len() * self.sensors.len() * size_of::<f32>()
+    }
+
+    /// Whether the sun's later-bounce coefficients are held
+    /// ([`MAX_SUN_ROW_BYTES`]), not solved again for each batch of suns.
+    fn holds_sun_rows(&self) -> bool {
+        self.sun_row_bytes() <= MAX_SUN_ROW_BYTES
     }
 
     /// Column lists of the form factors: for side j, every (i, F_ij).

@@ -16,9 +16,9 @@ use super::{Channels, LightModel, Lighting, SensorReading, par_map};
 use crate::sky::{LUMINOUS_EFFICACY, Sky};
 
 /// `start` + Σ_j F_ij M_j over one sparse row of form factors: the
-/// irradiance (RGB) that receiver i gets from sides leaving `exitance` M,
-/// added to what it already has.
-pub fn form_factor_product(start: [f64; 3], row: &[(u32, f32)], exitance: &[[f64; 3]]) -> [f64; 3] {
+/// irradiance (RGB, or one channel standing for grey RGB) that receiver i
+/// gets from sides leaving `exitance` M, added to what it already has.
+pub fn form_factor_product<const N: usize>(start: [f64; N], row: &[(u32, f32)], exitance: &[[f64; N]]) -> [f64; N] {
     let mut sum = start;
     for &(j, f) in row {
         for (s, m) in sum.iter_mut().zip(exitance[j as usize]) {
@@ -90,11 +90,10 @@ impl Interreflection {
         }
         let next: Vec<[f64; 3]> = if self.grey {
             // The first channel's products alone, in the same order: the same bits.
-            let exitance: Vec<f64> =
-                (0..self.direct.len()).map(|j| self.reflectance[j][0] * (self.direct[j] + self.indirect[j][0])).collect();
-            let next =
-                par_map(threads, self.direct.len(), |i| row(i).iter().fold(0.0, |sum, &(j, f)| sum + f64::from(f) * exitance[j as usize]));
-            next.into_iter().map(|e| [e; 3]).collect()
+            let exitance: Vec<[f64; 1]> =
+                (0..self.direct.len()).map(|j| [self.reflectance[j][0] * (self.direct[j] + self.indirect[j][0])]).collect();
+            let next = par_map(threads, self.direct.len(), |i| form_factor_product([0.0], row(i), &exitance));
+            next.into_iter().map(|[e]| [e; 3]).collect()
         } else {
             let exitance = self.exitance(|j| self.direct[j]);
             par_map(threads, self.direct.len(), |i| form_factor_product([0.0; 3], row(i), &exitance))
