@@ -24,7 +24,11 @@ over the space's floor, 0.3 m in from its edges too, as point sensors
 `<space>/<k>` (an L-shaped corridor's box reaches into the rooms beside it;
 a point 2 cm from a wall in the notch of such a space sees that wall as half
 its view, and refines the wall's patches around it to a few centimetres).
-A model whose only slabs are stair landings (Revit's Office_A: an
+A model with no IfcSpace (a design model exported before its rooms were
+placed) gets point sensors over its floor slabs instead, where something
+(a slab, a roof) covers them: 0.8 m above the slab's top, 0.3 m in from
+its edges and 0.3 m clear of every wall, column, door or frame that
+crosses that work plane, named after the storey and the slab. A model whose only slabs are stair landings (Revit's Office_A: an
 architect's export without the structure's slabs) is said to have no
 floors under its spaces. The site's latitude and
 longitude come from IfcSite when given there (0°, 0°, said so, where it gives
@@ -41,6 +45,7 @@ import sys
 try:
     import ifcopenshell
     import ifcopenshell.geom
+    import ifcopenshell.util.element
 except ImportError:
     sys.exit("tools/ifc_to_obj.py needs IfcOpenShell: pip install ifcopenshell")
 
@@ -158,6 +163,86 @@ def inside_floor(point, floor, inset):
     return all(over_floor(p, floor) for p in [point] + around)
 
 
+# Slabs that are no floor to read on.
+NOT_FLOORS = ("ROOF", "LANDING")
+# What stands in a room and keeps the floor's sensors clear of it, and what
+# covers one (a floor with nothing over it is a terrace).
+STANDING = ("IfcWall", "IfcColumn", "IfcDoor", "IfcWindow", "IfcCurtainWall", "IfcPlate", "IfcMember", "IfcRailing",
+            "IfcStair", "IfcStairFlight", "IfcBuildingElementProxy", "IfcBeam")
+COVERING = ("IfcSlab", "IfcRoof", "IfcCovering", "IfcPlate")
+# Sensors keep this far (m) in from a floor's edges and clear of what stands on it.
+CLEARANCE = 0.3
+# The work plane's height (m) above the floor.
+WORK_PLANE = 0.8
+
+
+def clear_and_covered(points, height, standing, covering):
+    """Per (x, y) point at `height`: whether it lies CLEARANCE or farther
+    from every triangle of `standing` that crosses the plane z = height, and
+    under a triangle of `covering` that passes more than CLEARANCE over it
+    (a pitched roof's, whose eaves are lower, counts where it is high)."""
+    import numpy as np
+    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    keep = np.ones(len(pts), dtype=bool)
+    if len(pts) == 0:
+        return keep
+    tris = np.asarray(standing, dtype=float).reshape(-1, 3, 3)
+    z = tris[:, :, 2]
+    crossing = tris[(z.min(axis=1) < height) & (z.max(axis=1) > height)]
+    # Each crossing triangle's cut by the plane: the two points where its edges cross it.
+    ends = []
+    for t in crossing:
+        cut = []
+        for i in range(3):
+            a, b = t[i], t[(i + 1) % 3]
+            if (a[2] - height) * (b[2] - height) < 0:
+                f = (height - a[2]) / (b[2] - a[2])
+                cut.append(a[:2] + f * (b[:2] - a[:2]))
+        if len(cut) == 2:
+            ends.append(cut)
+    if ends:
+        seg = np.asarray(ends)
+        a, d = seg[:, 0], seg[:, 1] - seg[:, 0]
+        length2 = np.maximum((d * d).sum(axis=1), 1e-12)
+        for start in range(0, len(pts), 256):
+            p = pts[start:start + 256, None, :]
+            f = np.clip(((p - a) * d).sum(axis=2) / length2, 0.0, 1.0)
+            gap = np.linalg.norm(p - (a + f[:, :, None] * d), axis=2).min(axis=1)
+            keep[start:start + 256] &= gap >= CLEARANCE
+    over = np.asarray(covering, dtype=float).reshape(-1, 3, 3)
+    over = over[over[:, :, 2].max(axis=1) > height + CLEARANCE]
+    covered = np.zeros(len(pts), dtype=bool)
+    if len(over):
+        a, b, c = over[:, 0, :2], over[:, 1, :2], over[:, 2, :2]
+        det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+        flat = np.abs(det) > 1e-9
+        a, b, c, det, z = a[flat], b[flat], c[flat], det[flat], over[flat, :, 2]
+        for start in range(0, len(pts), 256):
+            p = pts[start:start + 256, None, :]
+            u = ((p[..., 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (p[..., 1] - a[:, 1])) / det
+            v = ((b[:, 0] - a[:, 0]) * (p[..., 1] - a[:, 1]) - (p[..., 0] - a[:, 0]) * (b[:, 1] - a[:, 1])) / det
+            above = z[:, 0] + u * (z[:, 1] - z[:, 0]) + v * (z[:, 2] - z[:, 0]) > height + CLEARANCE
+            covered[start:start + 256] = ((u > 0) & (v > 0) & (u + v < 1) & above).any(axis=1)
+    return keep & covered
+
+
+def floor_tops(points, tris):
+    """A slab's top: its faces that look up, within 5 cm of the highest of
+    them, as corners; and that height."""
+    up = []
+    for t in range(len(tris) // 3):
+        a, b, c = (points[tris[3 * t + k]] for k in range(3))
+        nz = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
+        length = math.dist((0, 0, 0), [(b[1] - a[1]) * (c[2] - a[2]) - (b[2] - a[2]) * (c[1] - a[1]),
+                                       (b[2] - a[2]) * (c[0] - a[0]) - (b[0] - a[0]) * (c[2] - a[2]), nz])
+        if length > 0 and nz > 0.99 * length:
+            up.append((a, b, c))
+    if not up:
+        return [], None
+    top = max(p[2] for t in up for p in t)
+    return [t for t in up if min(p[2] for p in t) > top - 0.05], top
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("ifc")
@@ -173,6 +258,8 @@ def main():
     settings.set("use-world-coords", True)
     os.makedirs(a.out, exist_ok=True)
     vertices, faces, materials, spaces, skipped = [], {}, {}, [], {}
+    # For a model without spaces: the floor slabs' tops, what stands and what covers.
+    slab_tops, standing, covering = [], [], []
     names = dict(zip((s.id() for s in model.by_type("IfcSpace")), space_names(model.by_type("IfcSpace"))))
     glazed_windows = 0
     framed_members = set()
@@ -200,9 +287,19 @@ def main():
         else:
             base = len(vertices)
             vertices.extend(points)
+            tris = geometry.faces
+            corners = [[points[tris[3 * t + k]] for k in range(3)] for t in range(len(tris) // 3)]
+            if any(product.is_a(kind) for kind in STANDING):
+                standing.extend(corners)
+            if any(product.is_a(kind) for kind in COVERING):
+                covering.extend(corners)
+            if product.is_a("IfcSlab") and product.PredefinedType not in NOT_FLOORS:
+                top, height = floor_tops(points, tris)
+                if top:
+                    storey = ifcopenshell.util.element.get_container(product)
+                    slab_tops.append((name_of(f"{storey.Name if storey else ''} {product.Name or product.GlobalId}"), top, height))
             styles = geometry.materials
             ids = geometry.material_ids
-            tris = geometry.faces
             face_styles = [styles[ids[t]] if ids and ids[t] >= 0 and ids[t] < len(styles) else None for t in range(len(tris) // 3)]
             glaze_all = product.is_a("IfcWindow") and face_styles and all(transparency(st) <= 0.3 for st in face_styles)
             glazed_windows += bool(glaze_all)
@@ -273,23 +370,43 @@ def main():
                 f'timezone = {timezone}\n\n[model]\nobj = "model.obj"\n')
         used = set()
         partial = 0
-        for name, lo, hi, floor in spaces:
+        # Without spaces, the covered floors: (name, lo, hi, floor, which grid points to keep).
+        floors = []
+        if not any(hi[0] - lo[0] >= 0.6 + a.spacing and hi[1] - lo[1] >= 0.6 + a.spacing for _, lo, hi, _ in spaces):
+            for name, top, height in slab_tops:
+                lo = [min(p[k] for t in top for p in t) for k in range(2)] + [height]
+                hi = [max(p[k] for t in top for p in t) for k in range(2)] + [height]
+                floors.append((name, lo, hi, [[p[:2] for p in t] for t in top],
+                               lambda pts, h=height + WORK_PLANE: clear_and_covered(pts, h, standing, covering)))
+        floor_sensors = 0
+        for name, lo, hi, floor, keep in [(*s, None) for s in spaces] + floors:
             if hi[0] - lo[0] < 0.6 + a.spacing or hi[1] - lo[1] < 0.6 + a.spacing:
                 continue
-            while name in used:
-                name += "_"
-            used.add(name)
-            (x0, y0), (x1, y1), height = (lo[0] + 0.3, lo[1] + 0.3), (hi[0] - 0.3, hi[1] - 0.3), lo[2] + 0.8
+            (x0, y0), (x1, y1), height = (lo[0] + CLEARANCE, lo[1] + CLEARANCE), (hi[0] - CLEARANCE, hi[1] - CLEARANCE), lo[2] + WORK_PLANE
             # The grid's points as heliodon places them: centres of spacing cells from min.
             nx, ny = int((x1 - x0) / a.spacing + 1e-9), int((y1 - y0) / a.spacing + 1e-9)
             points = [(x0 + (i + 0.5) * a.spacing, y0 + (j + 0.5) * a.spacing) for j in range(ny) for i in range(nx)]
             inside = [k for k, p in enumerate(points) if over_floor(p, floor)]
-            if not floor or len(inside) == len(points):
+            whole = not floor or len(inside) == len(points)
+            if keep is not None:
+                inside = [k for k, ok in zip(inside, keep([points[k] for k in inside])) if ok]
+                whole = False
+            if not whole:
+                inside = [k for k in inside if inside_floor(points[k], floor, CLEARANCE)]
+                if not inside:
+                    continue
+            while name in used:
+                name += "_"
+            used.add(name)
+            if whole:
                 f.write(f'\n[[sensor_grids]]\nname = "{name}"\nmin = [{x0:.3f}, {y0:.3f}]\n'
                         f'max = [{x1:.3f}, {y1:.3f}]\nheight = {height:.3f}\nspacing = {a.spacing}\n')
                 continue
-            partial += 1
-            for k in [k for k in inside if inside_floor(points[k], floor, 0.3)]:
+            if keep is None:
+                partial += 1
+            else:
+                floor_sensors += len(inside)
+            for k in inside:
                 x, y = points[k]
                 f.write(f'\n[[sensors]]\nname = "{name}/{k}"\nposition = [{x:.3f}, {y:.3f}, {height:.3f}]\nnormal = [0.0, 0.0, 1.0]\n')
     for kind, count in sorted(skipped.items()):
@@ -300,6 +417,10 @@ def main():
     if framed_members:
         print(f"{len(framed_members)} IfcMember in a transparent style (mullions and transoms drawn in the glazing's style): "
               "read as opaque frames, their reflectance from the style's colour", file=sys.stderr)
+    if floors:
+        print(f"no IfcSpace with room for sensors: {floor_sensors} point sensors over {len(used)} of {len(floors)} floor slabs "
+              f"where something covers them, {WORK_PLANE} m above their tops, {CLEARANCE} m clear of their edges, walls and frames",
+              file=sys.stderr)
     if not used:
         print("no IfcSpace with room for sensors: scene.toml has none; add [[sensor_grids]] or [[sensors]] to it", file=sys.stderr)
     if partial:
@@ -310,7 +431,7 @@ def main():
         print(f"{what}: the spaces have no floors under them (an export without the structure's slabs?); "
               "their sensors read the ground's light through the floor that is not there", file=sys.stderr)
     print(f"{len(vertices)} vertices, {sum(len(v) for v in faces.values())} triangles, {len(materials)} materials, "
-          f"{len(used)} spaces with sensors -> {a.out}")
+          f"{len(used)} {'floors' if floors else 'spaces'} with sensors -> {a.out}")
 
 
 if __name__ == "__main__":
