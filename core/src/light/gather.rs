@@ -20,7 +20,7 @@ use super::sampling::{self, Rng, cosine_directions, sample_area, stratified_area
 use super::sun::SUN_POINTS_STREAM;
 use super::{LightModel, LightSettings, MAX_GLASS_DEPTH, MIN_WEIGHT, SURFACE_OFFSET, Surface, par_map, side_of};
 use crate::parallel::par_join;
-use crate::scene::{Scene, Sensor};
+use crate::scene::{Patch, Scene, Sensor};
 
 /// The memory the gathers may take, MiB: `$HELIODON_MEMORY_MB`, else 8 GiB.
 pub fn memory_budget_mib() -> u64 {
@@ -893,7 +893,7 @@ impl LightModel {
             let mut rng = Rng::new(3, i as u64);
             let (mut coefficients, mut hits) = (Vec::new(), Vec::new());
             let not_reflected = |way: Way| !way.reflected;
-            for point in place_sensor(self.tracer(), sensor, 1) {
+            for point in place_sensor(self.tracer(), &self.scene.patches.patches, sensor, 1) {
                 for dir in cosine_directions(sensor.normal.as_dvec3(), SEEN_PROBE_RAYS, &mut rng) {
                     self.follow(point, dir, 1.0, 0, Way::START, &not_reflected, &mut coefficients, &mut hits);
                 }
@@ -931,9 +931,9 @@ impl LightModel {
         probe_sky: &[Option<u32>],
     ) -> (SensorGeometry, Vec<u32>) {
         let normal = sensor.normal.as_dvec3();
-        let points = place_sensor(self.tracer(), sensor, 4);
+        let points = place_sensor(self.tracer(), &self.scene.patches.patches, sensor, 4);
         let sun_points = match sensor.size {
-            Some(_) => place_sensor(self.tracer(), sensor, self.settings.area_sensor_sun_grid),
+            Some(_) => place_sensor(self.tracer(), &self.scene.patches.patches, sensor, self.settings.area_sensor_sun_grid),
             None => points.clone(),
         };
         let centre = points.iter().sum::<DVec3>() / points.len() as f64;
@@ -1066,20 +1066,32 @@ impl StratumRay {
 
 /// Where a sensor measures: its position, or an n × n grid of cell centres
 /// over its square, lifted off a surface it lies on.
-fn place_sensor(tracer: &Tracer, sensor: &Sensor, n: usize) -> Vec<DVec3> {
+fn place_sensor(tracer: &Tracer, patches: &[Patch], sensor: &Sensor, n: usize) -> Vec<DVec3> {
     let normal = sensor.normal.as_dvec3();
     let [u, v] = sensor.axes.map(|a| a.as_dvec3());
     let mut centre = sensor.position.as_dvec3();
-    // Lying on a surface (within the lift, facing away from it): lift it.
     // Probe beside the point too, in case a ray down a shared edge slips between triangles.
     let probes = [DVec3::ZERO, u * 1e-4, v * 1e-4, -(u + v) * 1e-4];
+    // A surface it faces closer than the lift, front on (a sensor 5 mm under
+    // a ceiling, facing it), bounds the lift to half the way there: probed
+    // from beyond that surface, the sensor was lifted through it into the
+    // solid behind and read 0 lx. One met from behind is the one it lies
+    // in (a desk top 5 mm over a grid): it is lifted out of that.
+    let ahead = probes
+        .iter()
+        .filter_map(|&o| tracer.closest(centre + o, normal, 1e-6))
+        .filter(|hit| patches[hit.patch as usize].normal.as_dvec3().dot(normal) < 0.0)
+        .map(|hit| hit.distance)
+        .fold(f64::INFINITY, f64::min);
+    let lift = SENSOR_LIFT.min(0.5 * ahead);
+    // Lying on a surface (within the lift, facing away from it): lift it.
     let gap = probes
         .iter()
-        .filter_map(|&o| tracer.closest(centre + o + normal * SENSOR_LIFT, -normal, 0.0))
-        .map(|hit| hit.distance - SENSOR_LIFT)
+        .filter_map(|&o| tracer.closest(centre + o + normal * lift, -normal, 0.0))
+        .map(|hit| hit.distance - lift)
         .fold(f64::INFINITY, f64::min);
-    if gap <= SENSOR_LIFT * 0.01 {
-        centre += normal * (SENSOR_LIFT - gap.max(-SENSOR_LIFT)).max(0.0);
+    if gap <= lift * 0.01 {
+        centre += normal * (lift - gap.max(-lift)).max(0.0);
     }
     let Some(size) = sensor.size else { return vec![centre] };
     let size = f64::from(size);
@@ -1095,7 +1107,7 @@ fn place_sensor(tracer: &Tracer, sensor: &Sensor, n: usize) -> Vec<DVec3> {
 /// sensors: a 4 × 4 grid), for exporting them.
 pub fn sensor_points(scene: &Scene) -> Vec<Vec<DVec3>> {
     let tracer = Tracer::new(&scene.patches);
-    scene.sensors.iter().map(|s| place_sensor(&tracer, s, 4)).collect()
+    scene.sensors.iter().map(|s| place_sensor(&tracer, &scene.patches.patches, s, 4)).collect()
 }
 
 #[cfg(test)]
@@ -1224,6 +1236,36 @@ mod tests {
             .collect();
         for share in &shares {
             assert!((share / view_factor - 1.0).abs() < 0.005, "open sky {shares:?} of the view, the hole's view factor {view_factor}");
+        }
+    }
+
+    /// A sensor lying on the floor (or a few millimetres under it, as
+    /// rounding leaves a grid on a desk) is lifted off it; one a few
+    /// millimetres under the ceiling, facing it, stays in the room and sees
+    /// the ceiling: probed from beyond the ceiling, it was lifted through
+    /// it and read 0 lx.
+    #[test]
+    fn a_sensor_is_lifted_off_the_floor_it_lies_on_not_through_the_ceiling_it_faces() {
+        let mut obj = String::new();
+        room(&mut obj, 0.0);
+        let sensors = [("on_floor", 0.0), ("in_floor", -0.005), ("under_ceiling", 2.995), ("near_ceiling", 2.98)]
+            .map(|(name, z)| format!("[[sensors]]\nname = \"{name}\"\nposition = [2.0, 2.0, {z}]\nnormal = [0.0, 0.0, 1.0]\n"))
+            .concat();
+        let scene = scene_of("lift", &obj, &sensors);
+        let heights: Vec<f64> = sensor_points(&scene).iter().map(|points| points[0].z).collect();
+        assert!((heights[0] - SENSOR_LIFT).abs() < 1e-6 && (heights[1] - SENSOR_LIFT).abs() < 1e-6, "lifted off the floor: {heights:?}");
+        assert!((heights[2] - 2.995).abs() < 1e-6 && (heights[3] - 2.98).abs() < 1e-6, "left under the ceiling: {heights:?}");
+        let settings = LightSettings { rays_per_patch: 16, window_rays_per_patch: 4, ..LightSettings::default() };
+        let model = LightModel::precompute(scene.clone(), settings).unwrap();
+        for sensor in [2, 3] {
+            let ceiling: f64 = model
+                .sensor_gather(sensor)
+                .form_factors
+                .iter()
+                .filter(|&&(side, _)| scene.patches.patches[side as usize / 2].centroid.z > 2.99)
+                .map(|&(_, share)| f64::from(share))
+                .sum();
+            assert!(ceiling > 0.9, "sensor {sensor} sees the ceiling as {ceiling} of its view");
         }
     }
 
