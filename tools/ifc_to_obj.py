@@ -28,9 +28,10 @@ A model with no IfcSpace (a design model exported before its rooms were
 placed) gets point sensors over its floor slabs instead, where something
 (a slab, a roof) covers them: 0.8 m above the slab's top, 0.3 m in from
 its edges and 0.3 m clear of every wall, column, door or frame that
-crosses that work plane, named after the storey and the slab. A model whose only slabs are stair landings (Revit's Office_A: an
-architect's export without the structure's slabs) is said to have no
-floors under its spaces. The site's latitude and
+crosses that work plane, named after the storey and the slab. A model
+whose only slabs are stair landings (Revit's Office_A: an architect's
+export without the structure's slabs) is said to have no floors under its
+spaces. The site's latitude and
 longitude come from IfcSite when given there (0°, 0°, said so, where it gives
 none: give --latitude and --longitude), and without --timezone the
 standard time is that of the meridian nearest the longitude (said so: an
@@ -46,6 +47,7 @@ try:
     import ifcopenshell
     import ifcopenshell.geom
     import ifcopenshell.util.element
+    import numpy as np
 except ImportError:
     sys.exit("tools/ifc_to_obj.py needs IfcOpenShell: pip install ifcopenshell")
 
@@ -181,7 +183,6 @@ def clear_and_covered(points, height, standing, covering):
     from every triangle of `standing` that crosses the plane z = height, and
     under a triangle of `covering` that passes more than CLEARANCE over it
     (a pitched roof's, whose eaves are lower, counts where it is high)."""
-    import numpy as np
     pts = np.asarray(points, dtype=float).reshape(-1, 2)
     keep = np.ones(len(pts), dtype=bool)
     if len(pts) == 0:
@@ -272,12 +273,12 @@ def main():
         geometry = shape.geometry
         verts = geometry.verts
         points = [verts[k:k + 3] for k in range(0, len(verts), 3)]
+        tris = geometry.faces
+        corners = [[points[tris[3 * t + k]] for k in range(3)] for t in range(len(tris) // 3)]
         if product.is_a("IfcSpace"):
             if points:
                 lo = [min(p[k] for p in points) for k in range(3)]
                 hi = [max(p[k] for p in points) for k in range(3)]
-                tris = geometry.faces
-                corners = [[points[tris[3 * t + k]] for k in range(3)] for t in range(len(tris) // 3)]
                 # The floor: the faces of the space's solid that face down.
                 floor = [[p[:2] for p in c] for c in corners
                          if (c[1][0] - c[0][0]) * (c[2][1] - c[0][1]) - (c[2][0] - c[0][0]) * (c[1][1] - c[0][1]) < 0]
@@ -287,8 +288,6 @@ def main():
         else:
             base = len(vertices)
             vertices.extend(points)
-            tris = geometry.faces
-            corners = [[points[tris[3 * t + k]] for k in range(3)] for t in range(len(tris) // 3)]
             if any(product.is_a(kind) for kind in STANDING):
                 standing.extend(corners)
             if any(product.is_a(kind) for kind in COVERING):
@@ -372,7 +371,7 @@ def main():
         partial = 0
         # Without spaces, the covered floors: (name, lo, hi, floor, which grid points to keep).
         floors = []
-        if not any(hi[0] - lo[0] >= 0.6 + a.spacing and hi[1] - lo[1] >= 0.6 + a.spacing for _, lo, hi, _ in spaces):
+        if not any(hi[0] - lo[0] >= 2 * CLEARANCE + a.spacing and hi[1] - lo[1] >= 2 * CLEARANCE + a.spacing for _, lo, hi, _ in spaces):
             for name, top, height in slab_tops:
                 lo = [min(p[k] for t in top for p in t) for k in range(2)] + [height]
                 hi = [max(p[k] for t in top for p in t) for k in range(2)] + [height]
@@ -380,7 +379,7 @@ def main():
                                lambda pts, h=height + WORK_PLANE: clear_and_covered(pts, h, standing, covering)))
         floor_sensors = 0
         for name, lo, hi, floor, keep in [(*s, None) for s in spaces] + floors:
-            if hi[0] - lo[0] < 0.6 + a.spacing or hi[1] - lo[1] < 0.6 + a.spacing:
+            if hi[0] - lo[0] < 2 * CLEARANCE + a.spacing or hi[1] - lo[1] < 2 * CLEARANCE + a.spacing:
                 continue
             (x0, y0), (x1, y1), height = (lo[0] + CLEARANCE, lo[1] + CLEARANCE), (hi[0] - CLEARANCE, hi[1] - CLEARANCE), lo[2] + WORK_PLANE
             # The grid's points as heliodon places them: centres of spacing cells from min.
