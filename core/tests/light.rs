@@ -13,7 +13,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use heliodon_core::light::{LightModel, LightSettings};
+use heliodon_core::light::{LightModel, LightSettings, without_daylight};
 use heliodon_core::panel::PanelCatalog;
 use heliodon_core::scene::{Scene, load_scene};
 use heliodon_core::sky::{Sky, SkySpec, integrate_hemisphere};
@@ -1249,7 +1249,8 @@ fn a_windowless_room_is_dark_though_its_floor_runs_on_outside() {
     std::fs::write(dir.join("scene.toml"), scene).unwrap();
     let scene = load(&dir.join("scene.toml"));
     let model = LightModel::precompute(scene.clone(), LightSettings::default()).unwrap();
-    let readings = model.solve(&sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-06-21", "12:00"), None).sensors;
+    let noon = sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-06-21", "12:00");
+    let readings = model.solve(&noon, None).sensors;
     let (terrace, room): (Vec<_>, Vec<_>) = readings.iter().partition(|r| r.name == "terrace");
     assert!(terrace[0].total > 50_000.0, "the terrace is in the sun: {} lx", terrace[0].total);
     let brightest = room.iter().map(|r| r.total).fold(0.0, f64::max);
@@ -1257,6 +1258,12 @@ fn a_windowless_room_is_dark_though_its_floor_runs_on_outside() {
     // Not exactly 0: a few rays slip through the seams where faces meet
     // (single-precision ray tests). Without the cut, the room reads 386 lx.
     assert!(brightest < 1e-5 * terrace[0].total, "the closed room reads {brightest} lx");
+    // Said to read no daylight: the room's sensors, not the terrace; and
+    // nothing at night, when no sensor reads any.
+    let in_room: Vec<usize> = (0..readings.len()).filter(|&i| readings[i].name != "terrace").collect();
+    assert_eq!(without_daylight(&readings, &noon), in_room);
+    let night = sky_at(&scene, &SkySpec::Clear { turbidity: 2.45 }, "2026-06-21", "23:00");
+    assert!(without_daylight(&model.solve(&night, None).sensors, &night).is_empty());
 }
 
 /// Light through a stack of panes (a double-skin façade of double glazing,

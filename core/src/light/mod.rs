@@ -70,7 +70,7 @@ pub fn side_of(patch: u32, back: bool) -> u32 {
 
 use crate::parallel::par_map;
 use crate::scene::{MaterialKind, Scene};
-use crate::sky::SkyPatches;
+use crate::sky::{Sky, SkyPatches};
 use bvh::Tracer;
 use gather::SensorGeometry;
 use sampling::{Rng, cosine_directions};
@@ -213,6 +213,25 @@ impl SensorReading {
         let (direct_sun, direct_sky, indirect) = (direct_sun + 0.0, direct_sky + 0.0, indirect + 0.0);
         Self { name, total: direct_sun + direct_sky + indirect, direct_sun, direct_sky, indirect }
     }
+}
+
+/// A reading under this share of the sky's horizontal illuminance is no
+/// daylight, as in a room no window or opening lights: a sealed room reads
+/// nothing, or millionths where a ray slips through a seam. Revit's
+/// Office_A under a clear morning sky: 19 sensors in its restrooms, lit
+/// through their doors at most, read 0–0.6 lx; its inner rooms lit through
+/// a corridor, 1–3.5 lx, and its lit offices 20 lx and more.
+const NO_DAYLIGHT: f64 = 1e-5;
+
+/// The sensors (indices of `readings`) that `sky` gives no daylight:
+/// under [`NO_DAYLIGHT`] of its horizontal illuminance. None where the sky
+/// sheds no light (at night).
+pub fn without_daylight(readings: &[SensorReading], sky: &Sky) -> Vec<usize> {
+    let outside = sky.global_horizontal() * crate::sky::LUMINOUS_EFFICACY;
+    if outside <= 0.0 {
+        return Vec::new();
+    }
+    readings.iter().enumerate().filter(|(_, r)| r.total < NO_DAYLIGHT * outside).map(|(i, _)| i).collect()
 }
 
 /// The light for one sun and sky.

@@ -293,6 +293,11 @@ impl Sky {
         self.sun.filter(|s| s.direction.z > 0.0)
     }
 
+    /// Irradiance on an unobstructed horizontal plane, sun and sky, W/m².
+    pub fn global_horizontal(&self) -> f64 {
+        self.diffuse_horizontal + self.sun_up().map_or(0.0, |s| s.normal_irradiance() * s.direction.z)
+    }
+
     /// Evaluates a sky for a sun at `altitude` and `azimuth` (degrees,
     /// apparent altitude, azimuth clockwise from north). `day_of_year` enters
     /// the Perez sky's brightness (gendaylit's `-ang` uses 0).

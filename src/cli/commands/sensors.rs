@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use crate::cli::CliError;
 use crate::cli::args::{Format, LightArgs, SkyArgs, load_for_command, precompute_for_command, sky_for};
-use crate::light::Lighting;
+use crate::light::{Lighting, without_daylight};
 use crate::panel::PanelCatalog;
 use crate::report::{csv_field, json_string};
 use crate::time::{Date, LocalDateTime, TimeOfDay};
@@ -90,9 +90,19 @@ pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, Stri
         let _ = writeln!(out, "{}name,illuminance_lux,direct_sun_lux,direct_sky_lux,indirect_lux", if several { "date,time," } else { "" });
     }
     let mut json = Vec::new();
+    // Per sensor: whether every case with daylight left it without any.
+    let mut dark: Option<Vec<bool>> = None;
     for when in cases {
         let (position, sky) = sky_for(&scene, &spec, &args.sky.sky, when)?;
         let lighting = model.solve(&sky, previous.as_ref());
+        if sky.global_horizontal() > 0.0 {
+            let mut here = vec![false; lighting.sensors.len()];
+            without_daylight(&lighting.sensors, &sky).into_iter().for_each(|i| here[i] = true);
+            dark = Some(match dark {
+                Some(before) => before.iter().zip(&here).map(|(a, b)| *a && *b).collect(),
+                None => here,
+            });
+        }
         match args.format {
             Format::Csv => {
                 for r in &lighting.sensors {
@@ -144,6 +154,16 @@ pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, Stri
     }
     if args.format == Format::Json {
         let _ = writeln!(out, "{}", if several { format!("[{}]", json.join(", ")) } else { json.concat() });
+    }
+    let dark: Vec<&str> =
+        dark.unwrap_or_default().iter().zip(&scene.sensors).filter(|(dark, _)| **dark).map(|(_, s)| s.name.as_str()).collect();
+    if !dark.is_empty() {
+        let who = if dark.len() == 1 { "a sensor reads".to_string() } else { format!("{} sensors read", dark.len()) };
+        eprintln!(
+            "warning: {}: {who} almost no daylight (under 0.001% of the sky's horizontal illuminance, as in a room no window or opening lights): {}",
+            args.scene.display(),
+            first_few(&dark)
+        );
     }
     Ok(out)
 }
