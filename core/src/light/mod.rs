@@ -223,15 +223,12 @@ impl SensorReading {
 /// a corridor, 1–3.5 lx, and its lit offices 20 lx and more.
 const NO_DAYLIGHT: f64 = 1e-5;
 
-/// The sensors (indices of `readings`) that `sky` gives no daylight:
-/// under [`NO_DAYLIGHT`] of its horizontal illuminance. None where the sky
-/// sheds no light (at night).
-pub fn without_daylight(readings: &[SensorReading], sky: &Sky) -> Vec<usize> {
+/// Per reading, whether `sky` gives it no daylight: under [`NO_DAYLIGHT`]
+/// of the sky's horizontal illuminance. `None` where the sky sheds no
+/// light (at night), which tells nothing.
+pub fn without_daylight(readings: &[SensorReading], sky: &Sky) -> Option<Vec<bool>> {
     let outside = sky.global_horizontal() * crate::sky::LUMINOUS_EFFICACY;
-    if outside <= 0.0 {
-        return Vec::new();
-    }
-    readings.iter().enumerate().filter(|(_, r)| r.total < NO_DAYLIGHT * outside).map(|(i, _)| i).collect()
+    (outside > 0.0).then(|| readings.iter().map(|r| r.total < NO_DAYLIGHT * outside).collect())
 }
 
 /// The light for one sun and sky.

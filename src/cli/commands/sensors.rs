@@ -95,9 +95,7 @@ pub fn sensors(args: &SensorsArgs, panels: &PanelCatalog) -> Result<String, Stri
     for when in cases {
         let (position, sky) = sky_for(&scene, &spec, &args.sky.sky, when)?;
         let lighting = model.solve(&sky, previous.as_ref());
-        if sky.global_horizontal() > 0.0 {
-            let mut here = vec![false; lighting.sensors.len()];
-            without_daylight(&lighting.sensors, &sky).into_iter().for_each(|i| here[i] = true);
+        if let Some(here) = without_daylight(&lighting.sensors, &sky) {
             dark = Some(match dark {
                 Some(before) => before.iter().zip(&here).map(|(a, b)| *a && *b).collect(),
                 None => here,
