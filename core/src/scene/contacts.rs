@@ -153,10 +153,14 @@ fn same_plane((n, d): Plane, (m, e): Plane) -> bool {
 }
 
 /// Per surface, the planes of the large faces that meet it along a line
-/// inside it, where its patches are cut.
-pub fn contact_cuts(large: &LargeFaces, surfaces: &[Surface]) -> Vec<Vec<CutPlane>> {
+/// inside it, where its patches are cut; none for the surfaces not
+/// `wanted`.
+pub fn contact_cuts(large: &LargeFaces, surfaces: &[Surface], wanted: impl Fn(usize) -> bool + Sync) -> Vec<Vec<CutPlane>> {
     let (triangles, grid) = (large.triangles, &large.grid);
     par_map(None, surfaces.len(), |index| {
+        if !wanted(index) {
+            return Vec::new();
+        }
         let surface = &surfaces[index];
         let own = surface.triangle_indices();
         let tris = &triangles[own.clone()];
@@ -438,7 +442,7 @@ mod tests {
         let beside = quad(1, [[0.0, 3.0, 0.5], [4.0, 3.0, 0.5], [4.0, 3.0, 3.0], [0.0, 3.0, 3.0]]);
         let lying = quad(2, [[1.0, 1.0, 0.0], [2.0, 1.0, 0.0], [2.0, 2.0, 0.0], [1.0, 2.0, 0.0]]);
         let (triangles, surfaces) = surfaces(&[slab, wall, beside, lying]);
-        let cuts = contact_cuts(&LargeFaces::new(&triangles, &surfaces, 0.01), &surfaces);
+        let cuts = contact_cuts(&LargeFaces::new(&triangles, &surfaces, 0.01), &surfaces, |_| true);
         // The slab: one plane, the wall's (y = 0), cutting along its foot.
         assert_eq!(cuts[0].len(), 1, "{:?}", cuts[0]);
         let cut = cuts[0][0];
@@ -463,7 +467,7 @@ mod tests {
         let slab_top = quad(0, [[0.0, 0.0, 2.7], [0.0, -3.0, 2.7], [4.0, -3.0, 2.7], [4.0, 0.0, 2.7]]);
         for wall in [[below, above].concat(), whole] {
             let (triangles, surfaces) = surfaces(&[wall, slab_top.clone()]);
-            let cuts = contact_cuts(&LargeFaces::new(&triangles, &surfaces, 0.01), &surfaces);
+            let cuts = contact_cuts(&LargeFaces::new(&triangles, &surfaces, 0.01), &surfaces, |_| true);
             assert_eq!(cuts[0].len(), 1, "{:?}", cuts[0]);
             assert!(cuts[0][0].normal.z.abs() > 0.999 && (cuts[0][0].offset.abs() - 2.7).abs() < 1e-5, "{:?}", cuts[0][0]);
         }
@@ -482,7 +486,7 @@ mod tests {
         let floor = quad(0, [[0.0, 0.5, 0.0], [12.0, 0.5, 0.0], [12.0, 6.0, 0.0], [0.0, 6.0, 0.0]]);
         let leg = quad(2, [[8.0, 3.0, -0.001], [8.05, 3.0, -0.001], [8.05, 3.0, 0.45], [8.0, 3.0, 0.45]]);
         let (triangles, surfaces) = surfaces(&[wall, rafter, floor, leg]);
-        let cuts = contact_cuts(&LargeFaces::new(&triangles, &surfaces, 1.0), &surfaces);
+        let cuts = contact_cuts(&LargeFaces::new(&triangles, &surfaces, 1.0), &surfaces, |_| true);
         assert_eq!(cuts[1].len(), 1, "{:?}", cuts[1]);
         let cut = cuts[1][0];
         assert!(cut.normal.y.abs() > 0.999 && cut.offset.abs() < 1e-6, "{cut:?}");
@@ -500,7 +504,7 @@ mod tests {
             .collect();
         let beam = quad(1, [[-0.5, 4.96, 5.9], [-0.5, 5.04, 5.9], [12.0, 5.04, 5.9], [12.0, 4.96, 5.9]]);
         let (triangles, surfaces) = self::surfaces(&[fan, beam]);
-        let cuts = contact_cuts(&LargeFaces::new(&triangles, &surfaces, 1.0), &surfaces);
+        let cuts = contact_cuts(&LargeFaces::new(&triangles, &surfaces, 1.0), &surfaces, |_| true);
         assert!(cuts[1].iter().any(|c| c.normal.x.abs() > 0.999 && c.offset.abs() < 1e-6), "{:?}", cuts[1]);
     }
 
@@ -513,7 +517,7 @@ mod tests {
         let leaf = |y: f32, z: f32| quad(1, [[0.0, y, z], [1.0, y, z], [1.0, y, 2.0], [0.0, y, 2.0]]);
         let board = quad(2, [[3.0, 3.0, 0.004], [4.0, 3.0, 0.004], [4.0, 4.0, 0.004], [3.0, 4.0, 0.004]]);
         let (triangles, surfaces) = surfaces(&[floor, leaf(0.0, 0.004), leaf(2.0, 0.05), board]);
-        let cuts = contact_cuts(&LargeFaces::new(&triangles, &surfaces, 0.01), &surfaces);
+        let cuts = contact_cuts(&LargeFaces::new(&triangles, &surfaces, 0.01), &surfaces, |_| true);
         assert_eq!(cuts[0].len(), 1, "{:?}", cuts[0]);
         let cut = cuts[0][0];
         assert!(cut.normal.y.abs() > 0.999 && cut.offset.abs() < 1e-6, "{cut:?}");
