@@ -57,13 +57,14 @@ fn test_room_loads_with_its_six_windows() {
     assert!((opaque - (108.0 - 4.59)).abs() < 1e-3, "{opaque}");
     // Patches cover every surface exactly and are no larger than a grid cell
     // and a half (a sliver along a wall's edge joins the cell beside it), but
-    // for 1 m cells 4 m from the windows and more: the ceiling's, 2.2 m over
-    // the grid, and the floor's, behind it.
+    // for 1 m cells 4 m from the windows and more, a metre and more from the
+    // grid (0.5 m in from the walls, 0.8 m up): the ceiling's, 2.2 m over it,
+    // the walls' above 1.8 m, and the floor's, behind it.
     let patch_area: f32 = scene.patches.patches.iter().map(|p| p.area).sum();
     let surface_area: f32 = scene.surfaces.iter().map(|s| s.area).sum();
     assert!((patch_area - surface_area).abs() < 1e-3);
     let material = |name: &str| scene.materials.iter().position(|m| m.name == name).unwrap() as u32;
-    let (ceiling, floor) = (material("ceiling"), material("floor"));
+    let (ceiling, floor, wall) = (material("ceiling"), material("floor"), material("wall"));
     let wide = |p: &&heliodon_core::scene::Patch| p.area > 1.5 * 0.25 + 1e-5;
     assert!(
         scene
@@ -71,17 +72,19 @@ fn test_room_loads_with_its_six_windows() {
             .patches
             .iter()
             .filter(wide)
-            .all(|p| [ceiling, floor].contains(&p.material) && p.centroid.y > 4.0 && p.area <= 1.0 + 1e-5)
+            .all(|p| ([ceiling, floor].contains(&p.material) || (p.material == wall && p.centroid.z > 1.8))
+                && p.centroid.y > 4.0
+                && p.area <= 1.0 + 1e-5)
     );
     for coarser in [ceiling, floor] {
         assert!(scene.patches.patches.iter().any(|p| p.material == coarser && wide(&p)), "the ceiling's and the floor's backs are coarser");
     }
     assert!(scene.patches.patches.iter().filter(|p| p.area > 0.25 + 1e-5).count() > 0, "slivers joined the cells beside them");
-    // The floor (4 × 6 m) is 0.5 m patches but for two 1 m cells in its back
-    // corners: 4 m and more from the windows, behind the desks' sensors, and
-    // 2 m and more from the sensor on the back wall, which sees the rest.
+    // The floor (4 × 6 m) is 0.5 m patches but for the eight 1 m cells of its
+    // back 2 m: 4 m and more from the windows, behind the desks' sensors, and
+    // a metre and more from the sensor on the back wall, which sees them.
     let floor_patches: Vec<_> = scene.patches.patches.iter().filter(|p| p.material == floor).map(|p| (p.centroid, p.area)).collect();
-    assert_eq!(floor_patches.len(), 96 - 2 * 4 + 2, "{floor_patches:?}");
+    assert_eq!(floor_patches.len(), 96 - 8 * 4 + 8, "{floor_patches:?}");
 }
 
 #[test]
