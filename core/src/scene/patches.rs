@@ -104,7 +104,7 @@ impl PatchMesh {
                 Member::Piece(s, pieces) => (s, pieces),
             };
             for piece in pieces {
-                let a = 0.5 * (piece[1] - piece[0]).cross(piece[2] - piece[0]).length();
+                let a = piece_area(&piece);
                 area += a;
                 moment += a * (piece[0] + piece[1] + piece[2]) / 3.0;
                 normal += a * surfaces[surface as usize].normal;
@@ -146,6 +146,19 @@ impl PatchMesh {
 
 /// Pieces smaller than this (m²) are rounding slivers of clipping.
 const SLIVER_AREA: f32 = 1e-8;
+
+/// The area of a render triangle.
+fn piece_area(piece: &[Vec3; 3]) -> f32 {
+    0.5 * (piece[1] - piece[0]).cross(piece[2] - piece[0]).length()
+}
+
+/// The area-weighted centroid of render triangles, and their box.
+fn centroid_and_bounds(pieces: impl Iterator<Item = [Vec3; 3]> + Clone) -> (Vec3, Bounds) {
+    let area: f32 = pieces.clone().map(|t| piece_area(&t)).sum();
+    let centroid = pieces.clone().map(|t| piece_area(&t) * (t[0] + t[1] + t[2]) / 3.0).sum::<Vec3>() / area.max(f32::MIN_POSITIVE);
+    let bounds = pieces.flatten().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    (centroid, bounds)
+}
 
 /// Beyond the focus, the allowed patch side grows by this much per metre.
 const GROWTH: f32 = 0.25;
@@ -807,15 +820,11 @@ impl<'a> Clusters<'a> {
     /// side `allowed` is allowed; `planes` are those that cut the surface
     /// into pieces where it is one.
     fn add(&mut self, triangles: &[Triangle], surface: &Surface, allowed: f32, member: Member, planes: &[CutPlane]) {
-        let pieces: Vec<[Vec3; 3]> = match &member {
-            Member::Whole(_) => triangles.iter().map(|t| t.vertices).collect(),
-            Member::Piece(_, pieces) => pieces.clone(),
+        let (centroid, bounds) = match &member {
+            Member::Whole(_) => centroid_and_bounds(triangles.iter().map(|t| t.vertices)),
+            Member::Piece(_, pieces) => centroid_and_bounds(pieces.iter().copied()),
         };
-        let area_of = |t: &[Vec3; 3]| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
-        let area: f32 = pieces.iter().map(area_of).sum();
-        let centroid = pieces.iter().map(|t| area_of(t) * (t[0] + t[1] + t[2]) / 3.0).sum::<Vec3>() / area.max(f32::MIN_POSITIVE);
-        let bounds = pieces.iter().flatten().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-        let far = allowed >= FAR_SIDES * self.finest;
+        let far = is_far(allowed, self.finest);
         // Cubes of the allowed side, nested on the finest grid.
         let side = self.finest * (allowed / self.finest).log2().floor().exp2();
         let cube = (centroid / side).floor().as_i64vec3().to_array();
@@ -851,6 +860,12 @@ impl<'a> Clusters<'a> {
     }
 }
 
+/// Whether a place allowed patches `allowed` wide lies far from the focus
+/// ([`FAR_SIDES`]).
+fn is_far(allowed: f32, finest: f32) -> bool {
+    allowed >= FAR_SIDES * finest
+}
+
 /// A cutting plane, the same whichever way its normal points (to 0.001 in
 /// the normal, 2 mm in the offset), and the side of it `p` lies on.
 fn plane_key(plane: &CutPlane, p: Vec3) -> ([i32; 4], bool) {
@@ -861,9 +876,10 @@ fn plane_key(plane: &CutPlane, p: Vec3) -> ([i32; 4], bool) {
 }
 
 /// Cuts every surface into patches no larger than `sizing` allows, along
-/// the window planes `cuts` and, but far from the focus ([`FAR_SIDES`]),
-/// along where the `large` faces meet it (see [`super::contacts`]), gathers the clutter among the surfaces
-/// `clusterable` allows into clusters, and sets each surface's patch range.
+/// the window planes `cuts` and where the `large` faces meet it (see
+/// [`super::contacts`]; not clutter far from the focus, [`FAR_SIDES`]),
+/// gathers the clutter among the surfaces `clusterable` allows into
+/// clusters, and sets each surface's patch range.
 pub fn subdivide(
     triangles: &[Triangle],
     surfaces: &mut [Surface],
@@ -879,19 +895,18 @@ pub fn subdivide(
         let centroid = tris.iter().map(|t| t.centroid() * t.area()).sum::<Vec3>() / surface.area.max(f32::MIN_POSITIVE);
         clusterable[index].then(|| (centroid, sizing.allowed(centroid, 0.0)))
     });
-    let far_clutter = |index: usize| {
-        placed[index].is_some_and(|(_, allowed)| allowed >= FAR_SIDES * sizing.finest && surfaces[index].area < CLUTTER * allowed * allowed)
-    };
-    let contacts = contact_cuts(large, surfaces, |index| !far_clutter(index));
     // Clutter: small where it lies. It joins a cluster whole, or, where a
     // large face meeting it or a window plane near the focus cuts it, cut
     // there piece by piece: a rafter through a wall or a frame through its
-    // glass, clustered whole, lit the room inside with its sunlit end.
+    // glass, clustered whole, lit the room inside with its sunlit end. Far
+    // from the focus no face it meets cuts it.
     let clutter = |index: usize| placed[index].filter(|&(_, allowed)| surfaces[index].area < CLUTTER * allowed * allowed);
+    let far_clutter = |index: usize| clutter(index).is_some_and(|(_, allowed)| is_far(allowed, sizing.finest));
+    let contacts = contact_cuts(large, surfaces, |index| !far_clutter(index));
     let whole = |index: usize, allowed: f32| {
         let tris = &triangles[surfaces[index].triangle_indices()];
         let bounds = super::bounds(tris);
-        contacts[index].is_empty() && (allowed >= FAR_SIDES * sizing.finest || !cuts.iter().any(|c| c.cuts(tris, bounds)))
+        contacts[index].is_empty() && (is_far(allowed, sizing.finest) || !cuts.iter().any(|c| c.cuts(tris, bounds)))
     };
     // Each surface's patches, surface by surface on every core (none for clutter left whole).
     let shared: &[Surface] = surfaces;
@@ -931,7 +946,7 @@ pub fn subdivide(
             let mut area = 0.0;
             let mut moment = Vec3::ZERO;
             for piece in pieces {
-                let a = 0.5 * (piece[1] - piece[0]).cross(piece[2] - piece[0]).length();
+                let a = piece_area(&piece);
                 area += a;
                 moment += a * (piece[0] + piece[1] + piece[2]) / 3.0;
                 mesh.triangles.push(piece);
@@ -973,7 +988,7 @@ fn patches_of_surface(
             let pieces = cells.entry((cell.i, cell.j, above)).or_default();
             for k in 1..part.len().saturating_sub(1) {
                 let piece = [part[0], part[k], part[k + 1]];
-                if 0.5 * (piece[1] - piece[0]).cross(piece[2] - piece[0]).length() > SLIVER_AREA {
+                if piece_area(&piece) > SLIVER_AREA {
                     pieces.push(piece);
                 }
             }
@@ -1040,7 +1055,7 @@ fn merge_small_cells(tree: &Quadtree, cells: BTreeMap<CellKey, Pieces>) -> Vec<P
     let index: HashMap<CellKey, usize> = keys.iter().enumerate().map(|(k, &key)| (key, k)).collect();
     let leaves: Vec<Cell> = keys.iter().map(|&(i, j, _)| tree.leaf_at((i, j))).collect();
     let cell_area = |k: usize| tree.bounds(leaves[k]).2.powi(2);
-    let mut area: Vec<f32> = pieces.iter().map(|p| p.iter().map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()).sum()).collect();
+    let mut area: Vec<f32> = pieces.iter().map(|p| p.iter().map(piece_area).sum()).collect();
     // Each group's cells' box in the grid's cells: (i0, j0, i1, j1).
     let mut extent: Vec<[i64; 4]> =
         leaves.iter().map(|&leaf| [leaf.i, leaf.j, leaf.i + tree.span(leaf), leaf.j + tree.span(leaf)]).collect();
