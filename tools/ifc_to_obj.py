@@ -29,9 +29,10 @@ placed) gets point sensors over its floor slabs instead, where something
 (a slab, a roof) covers them: 0.8 m above the slab's top, 0.3 m in from
 its edges and 0.3 m clear of every wall, column, door or frame that
 crosses that work plane, named after the storey and the slab. A model
-whose only slabs are stair landings (Revit's Office_A: an architect's
-export without the structure's slabs) is said to have no floors under its
-spaces. The site's latitude and
+whose slabs are all stair landings or roofs (Revit's Office_A: an
+architect's export without the structure's slabs) has no floors under its
+spaces: each space's underside becomes its floor (material space_floor,
+reflectance 0.2), and that is said. The site's latitude and
 longitude come from IfcSite when given there (0°, 0°, said so, where it gives
 none: give --latitude and --longitude), and without --timezone the
 standard time is that of the meridian nearest the longitude (said so: an
@@ -143,26 +144,43 @@ def transparency(style):
     return style.transparency if style is not None and style.transparency == style.transparency else 0.0
 
 
-def over_floor(point, floor):
-    """Whether (x, y) lies over one of the floor's triangles (xy corners)."""
-    x, y = point
-    for (ax, ay), (bx, by), (cx, cy) in floor:
-        d = (bx - ax) * (cy - ay) - (cx - ax) * (by - ay)
-        if abs(d) < 1e-12:
-            continue
-        u = ((x - ax) * (cy - ay) - (cx - ax) * (y - ay)) / d
-        v = ((bx - ax) * (y - ay) - (x - ax) * (by - ay)) / d
-        if u >= -1e-9 and v >= -1e-9 and u + v <= 1 + 1e-9:
-            return True
-    return False
+def over_triangles(points, triangles):
+    """Per (x, y) point (rows) and triangle (columns; the x and y of its
+    corners count, a z is ignored): whether the point lies over the
+    triangle, edges included, and its barycentric coordinates (u, v) there.
+    Triangles seen edge-on from above hold no point."""
+    pts = np.asarray(points, dtype=float).reshape(-1, 1, 2)
+    tris = np.asarray(triangles, dtype=float)
+    tris = tris.reshape(len(tris), 3, -1)[:, :, :2]
+    a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]
+    det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+    flat = np.abs(det) < 1e-12
+    det = np.where(flat, 1.0, det)
+    u = ((pts[..., 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (pts[..., 1] - a[:, 1])) / det
+    v = ((b[:, 0] - a[:, 0]) * (pts[..., 1] - a[:, 1]) - (pts[..., 0] - a[:, 0]) * (b[:, 1] - a[:, 1])) / det
+    over = (u >= -1e-9) & (v >= -1e-9) & (u + v <= 1 + 1e-9) & ~flat
+    return over, u, v
 
 
-def inside_floor(point, floor, inset):
-    """Whether (x, y) lies over the floor and `inset` in from its edges: the
-    point and eight points that far around it over its triangles."""
-    x, y = point
-    around = [(x + inset * math.cos(k * math.pi / 4), y + inset * math.sin(k * math.pi / 4)) for k in range(8)]
-    return all(over_floor(p, floor) for p in [point] + around)
+def over_floor(points, floor):
+    """Per (x, y) point: whether it lies over one of the floor's triangles."""
+    if not floor or not len(points):
+        return np.zeros(len(points), dtype=bool)
+    over = np.zeros(len(points), dtype=bool)
+    for start in range(0, len(points), 256):
+        over[start:start + 256] = over_triangles(points[start:start + 256], floor)[0].any(axis=1)
+    return over
+
+
+def inside_floor(points, floor, inset):
+    """Per (x, y) point: whether it lies over the floor and `inset` in from
+    its edges (it and eight points that far around it over the floor)."""
+    around = [(inset * math.cos(k * math.pi / 4), inset * math.sin(k * math.pi / 4)) for k in range(8)]
+    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    inside = over_floor(pts, floor)
+    for dx, dy in around:
+        inside &= over_floor(pts + (dx, dy), floor)
+    return inside
 
 
 # Slabs that are no floor to read on.
@@ -172,6 +190,10 @@ NOT_FLOORS = ("ROOF", "LANDING")
 STANDING = ("IfcWall", "IfcColumn", "IfcDoor", "IfcWindow", "IfcCurtainWall", "IfcPlate", "IfcMember", "IfcRailing",
             "IfcStair", "IfcStairFlight", "IfcBuildingElementProxy", "IfcBeam")
 COVERING = ("IfcSlab", "IfcRoof", "IfcCovering", "IfcPlate")
+# The floor a space without a slab under it gets, and its reflectance
+# (a mid-grey floor finish; the IES's default floor reflectance is 0.2).
+MENDED_FLOOR = "space_floor"
+MENDED_REFLECTANCE = 0.2
 # Sensors keep this far (m) in from a floor's edges and clear of what stands on it.
 CLEARANCE = 0.3
 # The work plane's height (m) above the floor.
@@ -214,16 +236,11 @@ def clear_and_covered(points, height, standing, covering):
     over = over[over[:, :, 2].max(axis=1) > height + CLEARANCE]
     covered = np.zeros(len(pts), dtype=bool)
     if len(over):
-        a, b, c = over[:, 0, :2], over[:, 1, :2], over[:, 2, :2]
-        det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
-        flat = np.abs(det) > 1e-9
-        a, b, c, det, z = a[flat], b[flat], c[flat], det[flat], over[flat, :, 2]
+        z = over[:, :, 2]
         for start in range(0, len(pts), 256):
-            p = pts[start:start + 256, None, :]
-            u = ((p[..., 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (p[..., 1] - a[:, 1])) / det
-            v = ((b[:, 0] - a[:, 0]) * (p[..., 1] - a[:, 1]) - (p[..., 0] - a[:, 0]) * (b[:, 1] - a[:, 1])) / det
+            inside, u, v = over_triangles(pts[start:start + 256], over)
             above = z[:, 0] + u * (z[:, 1] - z[:, 0]) + v * (z[:, 2] - z[:, 0]) > height + CLEARANCE
-            covered[start:start + 256] = ((u > 0) & (v > 0) & (u + v < 1) & above).any(axis=1)
+            covered[start:start + 256] = (inside & above).any(axis=1)
     return keep & covered
 
 
@@ -264,6 +281,12 @@ def main():
     names = dict(zip((s.id() for s in model.by_type("IfcSpace")), space_names(model.by_type("IfcSpace"))))
     glazed_windows = 0
     framed_members = set()
+    # An export without floor slabs (only landings, or none) gets each
+    # space's underside as its floor: without one the rooms read the
+    # ground's light through a floor that is not there.
+    slabs = model.by_type("IfcSlab")
+    mend_floors = bool(model.by_type("IfcSpace")) and all(s.PredefinedType in NOT_FLOORS for s in slabs)
+    mended = 0
     iterator = ifcopenshell.geom.iterator(settings, model)
     if not iterator.initialize():
         sys.exit(f"{a.ifc}: no geometry IfcOpenShell can read")
@@ -280,9 +303,17 @@ def main():
                 lo = [min(p[k] for p in points) for k in range(3)]
                 hi = [max(p[k] for p in points) for k in range(3)]
                 # The floor: the faces of the space's solid that face down.
-                floor = [[p[:2] for p in c] for c in corners
-                         if (c[1][0] - c[0][0]) * (c[2][1] - c[0][1]) - (c[2][0] - c[0][0]) * (c[1][1] - c[0][1]) < 0]
-                spaces.append((names[product.id()], lo, hi, floor))
+                down = [c for c in corners
+                        if (c[1][0] - c[0][0]) * (c[2][1] - c[0][1]) - (c[2][0] - c[0][0]) * (c[1][1] - c[0][1]) < 0]
+                spaces.append((names[product.id()], lo, hi, [[p[:2] for p in c] for c in down]))
+                # Its floor: the faces at the bottom of its solid, turned to face up.
+                bottom = [c for c in down if max(p[2] for p in c) < lo[2] + 0.01]
+                if mend_floors and bottom:
+                    mended += 1
+                    materials.setdefault(MENDED_FLOOR, ("Kd", MENDED_REFLECTANCE))
+                    for c in bottom:
+                        vertices.extend([c[0], c[2], c[1]])
+                        faces.setdefault(MENDED_FLOOR, []).append((len(vertices) - 2, len(vertices) - 1, len(vertices)))
         elif product.is_a() in SKIP or any(product.is_a(kind) for kind in SKIP):
             skipped[product.is_a()] = skipped.get(product.is_a(), 0) + 1
         else:
@@ -385,13 +416,13 @@ def main():
             # The grid's points as heliodon places them: centres of spacing cells from min.
             nx, ny = int((x1 - x0) / a.spacing + 1e-9), int((y1 - y0) / a.spacing + 1e-9)
             points = [(x0 + (i + 0.5) * a.spacing, y0 + (j + 0.5) * a.spacing) for j in range(ny) for i in range(nx)]
-            inside = [k for k, p in enumerate(points) if over_floor(p, floor)]
+            inside = list(np.flatnonzero(over_floor(points, floor)))
             whole = not floor or len(inside) == len(points)
             if keep is not None:
                 inside = [k for k, ok in zip(inside, keep([points[k] for k in inside])) if ok]
                 whole = False
             if not whole:
-                inside = [k for k in inside if inside_floor(points[k], floor, CLEARANCE)]
+                inside = [k for k, ok in zip(inside, inside_floor([points[k] for k in inside], floor, CLEARANCE)) if ok]
                 if not inside:
                     continue
             while name in used:
@@ -424,11 +455,11 @@ def main():
         print("no IfcSpace with room for sensors: scene.toml has none; add [[sensor_grids]] or [[sensors]] to it", file=sys.stderr)
     if partial:
         print(f"{partial} spaces do not fill their box: point sensors over their floors instead of a grid", file=sys.stderr)
-    slabs = model.by_type("IfcSlab")
-    if used and all(s.PredefinedType == "LANDING" for s in slabs):
-        what = f"no IfcSlab but {len(slabs)} stair landings" if slabs else "no IfcSlab"
+    if mended:
+        what = f"no IfcSlab but {len(slabs)} stair landings or roofs" if slabs else "no IfcSlab"
         print(f"{what}: the spaces have no floors under them (an export without the structure's slabs?); "
-              "their sensors read the ground's light through the floor that is not there", file=sys.stderr)
+              f"{mended} spaces get their underside as a floor, material {MENDED_FLOOR} of reflectance {MENDED_REFLECTANCE} "
+              "(change it in model.mtl)", file=sys.stderr)
     print(f"{len(vertices)} vertices, {sum(len(v) for v in faces.values())} triangles, {len(materials)} materials, "
           f"{len(used)} {'floors' if floors else 'spaces'} with sensors -> {a.out}")
 
