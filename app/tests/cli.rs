@@ -114,6 +114,19 @@ fn info_summarises_each_bundled_scene() {
         .map(|class| class.split_whitespace().rev().nth(2).and_then(|n| n.parse::<usize>().ok()).expect("a count"))
         .sum();
     assert_eq!(counted, patches, "{out}");
+    // The surfaces cut past their area in finest cells, most first: the
+    // wall the windows' planes cut into strips around its six openings.
+    let most = out.lines().find_map(|l| l.strip_prefix("  most     ")).expect("most line");
+    assert!(most.contains(" of wall facing N (azimuth 0°) at (2.00, 0.00, "), "{out}");
+    let past: Vec<usize> = most
+        .split("; ")
+        .map(|surface| {
+            let number = |text: &str| text.split_whitespace().next().and_then(|n| n.parse::<usize>().ok()).expect("a count");
+            let cells = surface.split(" (").nth(1).map(number).expect("finest cells");
+            number(surface) - cells
+        })
+        .collect();
+    assert!(past.len() == 3 && past.windows(2).all(|w| w[0] >= w[1]) && past[2] > 0, "{out}");
     let Run { code, out, .. } = heliodon(&["info", "assets/scenes/office/scene.toml"], &scratch());
     assert_eq!(code, 0);
     assert!(out.contains("windows    12, 24.88 m² in all") && out.contains("facing W (azimuth 270°)"), "{out}");
