@@ -7,7 +7,7 @@
 //! them, with a margin; around all the windows when there are no
 //! sensors), and growing with the distance from it (a quarter of that
 //! distance, at most 64 × `patch_size`); away from the windows, patches
-//! may be as wide as half their distance from the sensors, at most twice
+//! may be as wide as their distance from the sensors, at most twice
 //! `patch_size` (a tall room's ceiling over its grid). So a room keeps
 //! today's grid, while the far ground, the site's context, the outside of the building
 //! far from its windows and the wings and storeys where no sensor reads
