@@ -164,10 +164,8 @@ def over_triangles(points, triangles):
 
 def over_floor(points, floor):
     """Per (x, y) point: whether it lies over one of the floor's triangles."""
-    if not floor or not len(points):
-        return np.zeros(len(points), dtype=bool)
     over = np.zeros(len(points), dtype=bool)
-    for start in range(0, len(points), 256):
+    for start in range(0, len(points) if floor else 0, 256):
         over[start:start + 256] = over_triangles(points[start:start + 256], floor)[0].any(axis=1)
     return over
 

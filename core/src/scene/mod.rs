@@ -189,6 +189,12 @@ impl Surface {
     pub fn patch_indices(&self) -> Range<usize> {
         self.patches.start as usize..self.patches.end as usize
     }
+
+    /// The area-weighted centroid of its triangles, given all the model's
+    /// `triangles` (those [`Self::triangles`] indexes).
+    pub fn centroid(&self, triangles: &[Triangle]) -> Vec3 {
+        triangles[self.triangle_indices()].iter().map(|t| t.centroid() * t.area()).sum::<Vec3>() / self.area.max(f32::MIN_POSITIVE)
+    }
 }
 
 /// An aperture: a surface of a transmitting material (glass or panel).

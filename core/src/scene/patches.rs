@@ -891,9 +891,10 @@ pub fn subdivide(
     let mut mesh = PatchMesh::default();
     // Per surface `clusterable` allows: its centroid and the side allowed there.
     let placed = par_map(None, surfaces.len(), |index| {
-        let (surface, tris) = (&surfaces[index], &triangles[surfaces[index].triangle_indices()]);
-        let centroid = tris.iter().map(|t| t.centroid() * t.area()).sum::<Vec3>() / surface.area.max(f32::MIN_POSITIVE);
-        clusterable[index].then(|| (centroid, sizing.allowed(centroid, 0.0)))
+        clusterable[index].then(|| {
+            let centroid = surfaces[index].centroid(triangles);
+            (centroid, sizing.allowed(centroid, 0.0))
+        })
     });
     // Clutter: small where it lies. It joins a cluster whole, or, where a
     // large face meeting it or a window plane near the focus cuts it, cut

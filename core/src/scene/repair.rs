@@ -42,8 +42,7 @@ pub const MAX_PANE_THICKNESS: f32 = 0.06;
 pub fn thick_glass(triangles: &[Triangle], surfaces: &[Surface], materials: &[Material]) -> (Vec<u32>, usize) {
     let glass: Vec<usize> = (0..surfaces.len()).filter(|&s| materials[surfaces[s].material as usize].kind.transmits()).collect();
     let tris = |s: usize| &triangles[surfaces[s].triangle_indices()];
-    let centroid = |s: usize| tris(s).iter().map(|t| t.centroid() * t.area()).sum::<Vec3>() / surfaces[s].area.max(f32::MIN_POSITIVE);
-    let centres: HashMap<usize, Vec3> = glass.iter().map(|&s| (s, centroid(s))).collect();
+    let centres: HashMap<usize, Vec3> = glass.iter().map(|&s| (s, surfaces[s].centroid(triangles))).collect();
     // Glass surfaces by the cell of their centre, for neighbours in near-linear time.
     let cell = |p: Vec3| (p / (2.0 * MAX_PANE_THICKNESS)).floor().as_ivec3().to_array();
     let mut grid: HashMap<[i32; 3], Vec<usize>> = HashMap::new();

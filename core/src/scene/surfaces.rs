@@ -93,8 +93,7 @@ pub fn windows(triangles: &[Triangle], surfaces: &[Surface], materials: &[Materi
         .enumerate()
         .filter(|(_, s)| materials[s.material as usize].kind.transmits())
         .map(|(index, surface)| {
-            let tris = &triangles[surface.triangle_indices()];
-            let centroid = tris.iter().map(|t| t.centroid() * t.area()).sum::<Vec3>() / surface.area;
+            let centroid = surface.centroid(triangles);
             Window { surface: index as u32, material: surface.material, area: surface.area, normal: surface.normal, centroid }
         })
         .collect()

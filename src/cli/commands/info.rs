@@ -172,14 +172,12 @@ fn patch_breakdown(scene: &Scene) -> String {
 /// and centre (canonical frame): a stair's stringer cut at every tread and
 /// riser, a partition a row of sensors stands beside, a façade's strips
 /// between its windows; the first places to look when a model has more
-/// patches than expected. A cluster's patch counts for its first surface.
+/// patches than expected. A cluster's patch counts for its first surface
+/// (it is listed there).
 fn most_cut_surfaces(scene: &Scene, count: usize) -> String {
-    let mut patches_of = vec![0usize; scene.surfaces.len()];
-    for patch in &scene.patches.patches {
-        patches_of[patch.surface as usize] += 1;
-    }
+    let patches_of = |s: usize| scene.surfaces[s].patch_indices().len();
     let finest_cells = |s: usize| (scene.surfaces[s].area / (scene.patch_size * scene.patch_size)).ceil() as usize;
-    let past_area = |s: usize| patches_of[s].saturating_sub(finest_cells(s));
+    let past_area = |s: usize| patches_of(s).saturating_sub(finest_cells(s));
     let mut order: Vec<usize> = (0..scene.surfaces.len()).filter(|&s| past_area(s) > 0).collect();
     order.sort_by(|&a, &b| past_area(b).cmp(&past_area(a)).then(a.cmp(&b)));
     let described: Vec<String> = order
@@ -187,11 +185,10 @@ fn most_cut_surfaces(scene: &Scene, count: usize) -> String {
         .take(count)
         .map(|&s| {
             let surface = &scene.surfaces[s];
-            let triangles = scene.surface_triangles(s as u32);
-            let centre = triangles.iter().map(|t| t.centroid() * t.area()).sum::<glam::Vec3>() / surface.area.max(f32::MIN_POSITIVE);
+            let centre = surface.centroid(&scene.triangles);
             format!(
                 "{} patches on {:.2} m² ({} finest cells) of {} facing {} at ({:.2}, {:.2}, {:.2})",
-                patches_of[s],
+                patches_of(s),
                 surface.area,
                 finest_cells(s),
                 scene.material(surface.material).name,
